@@ -1,0 +1,292 @@
+//! Images: linear f32 RGB, written as EXR (linear) or PNG (sRGB after
+//! exposure and a tone curve), always whole or not at all; and the error
+//! measures that `airlight compare` prints.
+
+use crate::Rgb;
+use crate::scene::Tonemap;
+use std::io;
+use std::path::{Path, PathBuf};
+
+/// A linear RGB image, row-major, pixel (0, 0) at the top-left.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Image {
+    pub width: u32,
+    pub height: u32,
+    pub pixels: Vec<Rgb>,
+}
+
+impl Image {
+    pub fn new(width: u32, height: u32) -> Self {
+        Image {
+            width,
+            height,
+            pixels: vec![Rgb::ZERO; width as usize * height as usize],
+        }
+    }
+
+    #[inline]
+    pub fn pixel(&self, x: u32, y: u32) -> Rgb {
+        self.pixels[(y * self.width + x) as usize]
+    }
+
+    /// The mean of all pixels.
+    pub fn mean(&self) -> Rgb {
+        let sum: glam::DVec3 = self.pixels.iter().map(|p| p.as_dvec3()).sum();
+        (sum / self.pixels.len().max(1) as f64).as_vec3()
+    }
+
+    /// Writes `.exr` (linear f32) or `.png` (8-bit sRGB after exposure and
+    /// tone curve), chosen by the extension. The file is written beside the
+    /// target under a temporary name and renamed, so a failure never leaves
+    /// a partial image.
+    pub fn write(&self, path: &Path, exposure: f32, tonemap: Tonemap) -> io::Result<()> {
+        let ext = path
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(str::to_ascii_lowercase);
+        let bytes = match ext.as_deref() {
+            Some("exr") => self.encode_exr()?,
+            Some("png") => self.encode_png(exposure, tonemap)?,
+            _ => {
+                return Err(io::Error::new(
+                    io::ErrorKind::InvalidInput,
+                    format!(
+                        "cannot tell the image format of `{}`: use .exr or .png",
+                        path.display()
+                    ),
+                ));
+            }
+        };
+        write_atomically(path, &bytes)
+    }
+
+    fn encode_exr(&self) -> io::Result<Vec<u8>> {
+        use exr::prelude::*;
+        let (w, h) = (self.width as usize, self.height as usize);
+        let channels = SpecificChannels::rgb(|pos: Vec2<usize>| {
+            let p = self.pixels[pos.y() * w + pos.x()];
+            (p.x, p.y, p.z)
+        });
+        let image = exr::prelude::Image::from_channels((w, h), channels);
+        let mut out = io::Cursor::new(Vec::new());
+        image
+            .write()
+            .to_buffered(&mut out)
+            .map_err(io::Error::other)?;
+        Ok(out.into_inner())
+    }
+
+    fn encode_png(&self, exposure: f32, tonemap: Tonemap) -> io::Result<Vec<u8>> {
+        let scale = exposure.exp2();
+        let mut rgb = Vec::with_capacity(self.pixels.len() * 3);
+        for p in &self.pixels {
+            for c in p.to_array() {
+                rgb.push(to_srgb8(tone(c * scale, tonemap)));
+            }
+        }
+        let mut out = io::Cursor::new(Vec::new());
+        image::ImageEncoder::write_image(
+            image::codecs::png::PngEncoder::new(&mut out),
+            &rgb,
+            self.width,
+            self.height,
+            image::ExtendedColorType::Rgb8,
+        )
+        .map_err(io::Error::other)?;
+        Ok(out.into_inner())
+    }
+
+    /// Reads an EXR's RGB channels.
+    pub fn read_exr(path: &Path) -> io::Result<Image> {
+        use exr::prelude::*;
+        let image = read_first_rgba_layer_from_file(
+            path,
+            |res, _| (res.width(), vec![Rgb::ZERO; res.width() * res.height()]),
+            |(stride, pixels), pos, (r, g, b, _a): (f32, f32, f32, f32)| {
+                pixels[pos.y() * *stride + pos.x()] = Rgb::new(r, g, b)
+            },
+        )
+        .map_err(|e| {
+            io::Error::new(
+                io::ErrorKind::InvalidData,
+                format!("{}: {e}", path.display()),
+            )
+        })?;
+        let size = image.layer_data.size;
+        let (_, pixels) = image.layer_data.channel_data.pixels;
+        Ok(Self {
+            width: size.x() as u32,
+            height: size.y() as u32,
+            pixels,
+        })
+    }
+}
+
+/// A tone curve applied to a linear value.
+pub fn tone(x: f32, tonemap: Tonemap) -> f32 {
+    let x = x.max(0.0);
+    match tonemap {
+        Tonemap::Clamp => x.min(1.0),
+        // Narkowicz, "ACES Filmic Tone Mapping Curve" (2015).
+        Tonemap::Filmic => {
+            ((x * (2.51 * x + 0.03)) / (x * (2.43 * x + 0.59) + 0.14)).clamp(0.0, 1.0)
+        }
+    }
+}
+
+/// The sRGB transfer function (IEC 61966-2-1) to 8 bits.
+pub fn to_srgb8(linear: f32) -> u8 {
+    let v = linear.clamp(0.0, 1.0);
+    let s = if v <= 0.003_130_8 {
+        12.92 * v
+    } else {
+        1.055 * v.powf(1.0 / 2.4) - 0.055
+    };
+    (s * 255.0 + 0.5) as u8
+}
+
+/// Writes `bytes` to `path` through a temporary file in the same directory
+/// and a rename, so readers see the old file or the whole new one.
+pub fn write_atomically(path: &Path, bytes: &[u8]) -> io::Result<()> {
+    let name = path
+        .file_name()
+        .ok_or_else(|| io::Error::new(io::ErrorKind::InvalidInput, "no file name"))?;
+    let mut tmp_name = std::ffi::OsString::from(".");
+    tmp_name.push(name);
+    tmp_name.push(format!(".tmp-{}", std::process::id()));
+    let tmp: PathBuf = path.with_file_name(tmp_name);
+    let result = std::fs::write(&tmp, bytes).and_then(|_| std::fs::rename(&tmp, path));
+    if result.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    result
+}
+
+/// Differences between an image and a reference, over all pixels and channels.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ImageError {
+    /// √(mean (a − b)²)
+    pub rmse: f64,
+    /// mean (a − b)² / (b² + 0.01): the relative MSE of Rousselle, Knaus and
+    /// Zwicker (2011), ε = 0.01 keeping dark pixels from dominating.
+    pub rel_mse: f64,
+    /// mean |a − b|
+    pub mae: f64,
+    /// max |a − b|
+    pub max: f64,
+    /// √(Σ (a − b)² / Σ b²): the RMSE relative to the reference's RMS. The
+    /// "relative RMSE" that tests and benchmarks quote.
+    pub rel_rmse: f64,
+}
+
+/// Compares `image` against `reference`; None if their sizes differ.
+pub fn compare(image: &Image, reference: &Image) -> Option<ImageError> {
+    if image.width != reference.width || image.height != reference.height {
+        return None;
+    }
+    let (mut se, mut rel, mut abs, mut max, mut ref2) = (0.0f64, 0.0f64, 0.0f64, 0.0f64, 0.0f64);
+    for (a, b) in image.pixels.iter().zip(&reference.pixels) {
+        for c in 0..3 {
+            let (a, b) = (a[c] as f64, b[c] as f64);
+            let d = a - b;
+            se += d * d;
+            rel += d * d / (b * b + 0.01);
+            abs += d.abs();
+            max = max.max(d.abs());
+            ref2 += b * b;
+        }
+    }
+    let n = (image.pixels.len() * 3).max(1) as f64;
+    Some(ImageError {
+        rmse: (se / n).sqrt(),
+        rel_mse: rel / n,
+        mae: abs / n,
+        max,
+        rel_rmse: if ref2 > 0.0 {
+            (se / ref2).sqrt()
+        } else if se == 0.0 {
+            0.0
+        } else {
+            f64::INFINITY
+        },
+    })
+}
+
+/// An error map: |a − b| averaged over channels, scaled so that `scale`
+/// maps to white.
+pub fn error_map(image: &Image, reference: &Image, scale: f32) -> Image {
+    let pixels = image
+        .pixels
+        .iter()
+        .zip(&reference.pixels)
+        .map(|(a, b)| Rgb::splat(((*a - *b).abs().element_sum() / 3.0) / scale.max(1e-30)))
+        .collect();
+    Image {
+        width: image.width,
+        height: image.height,
+        pixels,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn exr_round_trips_exactly() {
+        let mut img = Image::new(5, 3);
+        for (i, p) in img.pixels.iter_mut().enumerate() {
+            *p = Rgb::new(i as f32 * 0.25, 1.0 / (i as f32 + 1.0), 1e-3 * i as f32);
+        }
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("a.exr");
+        img.write(&path, 0.0, Tonemap::Clamp).unwrap();
+        assert_eq!(Image::read_exr(&path).unwrap(), img);
+        // Nothing temporary is left behind.
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+    }
+
+    #[test]
+    fn a_failed_write_leaves_no_file() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("missing-dir").join("a.png");
+        assert!(Image::new(2, 2).write(&path, 0.0, Tonemap::Clamp).is_err());
+        assert!(!path.exists());
+        assert!(
+            Image::new(2, 2)
+                .write(&dir.path().join("a.tiff"), 0.0, Tonemap::Clamp)
+                .is_err()
+        );
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
+    }
+
+    #[test]
+    fn srgb_curve_hits_known_values() {
+        assert_eq!(to_srgb8(0.0), 0);
+        assert_eq!(to_srgb8(1.0), 255);
+        // 0.5 linear is 0.7354 in sRGB: 187.5 → 188.
+        assert_eq!(to_srgb8(0.5), 188);
+        assert!(tone(1e6, Tonemap::Filmic) <= 1.0);
+    }
+
+    #[test]
+    fn compare_measures_known_differences() {
+        let a = Image {
+            width: 2,
+            height: 1,
+            pixels: vec![Rgb::splat(1.0), Rgb::splat(0.0)],
+        };
+        let b = Image {
+            width: 2,
+            height: 1,
+            pixels: vec![Rgb::splat(1.0), Rgb::splat(0.5)],
+        };
+        let e = compare(&a, &b).unwrap();
+        assert!((e.rmse - (0.125f64).sqrt()).abs() < 1e-12);
+        assert!((e.mae - 0.25).abs() < 1e-12);
+        assert_eq!(e.max, 0.5);
+        assert!((e.rel_mse - 0.5 * 0.25 / 0.26).abs() < 1e-12);
+        assert!((e.rel_rmse - (0.75f64 / 3.75).sqrt()).abs() < 1e-12);
+        assert!(compare(&a, &Image::new(1, 1)).is_none());
+    }
+}

@@ -1,0 +1,411 @@
+//! The scene's geometry as flat primitives under one BVH (obvhs's compressed
+//! wide BVH8), plus infinite planes, which no bounding box holds and which are
+//! tested one by one.
+
+use super::Ray;
+use super::shape::{
+    Shape, box_normal, intersect_box, intersect_quad, intersect_sphere, intersect_triangle,
+};
+use glam::{Affine3A, Mat3, Vec3, Vec3A};
+use obvhs::{Boundable, BvhBuildParams, aabb::Aabb, cwbvh::CwBvh};
+use std::time::Duration;
+
+/// One primitive the BVH holds.
+#[derive(Clone, Debug)]
+enum Prim {
+    Sphere {
+        center: Vec3,
+        radius: f32,
+    },
+    Quad {
+        corner: Vec3,
+        edge_u: Vec3,
+        edge_v: Vec3,
+    },
+    Box {
+        min: Vec3,
+        max: Vec3,
+    },
+    Triangle {
+        v0: Vec3,
+        e1: Vec3,
+        e2: Vec3,
+    },
+    /// A sphere or box in its own space.
+    Instance(std::boxed::Box<Instance>),
+}
+
+#[derive(Clone, Debug)]
+struct Instance {
+    prim: Prim,
+    local_from_world: Affine3A,
+    /// Maps local normals to world normals: the inverse transpose of the
+    /// linear part of world_from_local.
+    normal_to_world: Mat3,
+    bounds: Aabb,
+}
+
+#[derive(Clone, Debug)]
+struct Record {
+    prim: Prim,
+    material: u32,
+    emitter: Option<u32>,
+}
+
+#[derive(Clone, Debug)]
+struct PlaneRecord {
+    point: Vec3,
+    normal: Vec3,
+    material: u32,
+}
+
+impl Prim {
+    #[inline]
+    fn intersect(&self, o: Vec3, d: Vec3, tmin: f32, tmax: f32) -> f32 {
+        match self {
+            Prim::Sphere { center, radius } => intersect_sphere(*center, *radius, o, d, tmin, tmax),
+            Prim::Quad {
+                corner,
+                edge_u,
+                edge_v,
+            } => intersect_quad(*corner, *edge_u, *edge_v, o, d, tmin, tmax),
+            Prim::Box { min, max } => intersect_box(*min, *max, o, d, tmin, tmax),
+            Prim::Triangle { v0, e1, e2 } => intersect_triangle(*v0, *e1, *e2, o, d, tmin, tmax),
+            Prim::Instance(inst) => {
+                let lo = inst.local_from_world.transform_point3(o);
+                let ld = inst.local_from_world.transform_vector3(d);
+                inst.prim.intersect(lo, ld, tmin, tmax)
+            }
+        }
+    }
+
+    /// The outward unit normal at a point `p` on the primitive.
+    fn normal(&self, p: Vec3) -> Vec3 {
+        match self {
+            Prim::Sphere { center, .. } => (p - *center).normalize(),
+            Prim::Quad { edge_u, edge_v, .. } => edge_u.cross(*edge_v).normalize(),
+            Prim::Box { min, max } => box_normal(*min, *max, p),
+            Prim::Triangle { e1, e2, .. } => e1.cross(*e2).normalize(),
+            Prim::Instance(inst) => {
+                let local = inst.prim.normal(inst.local_from_world.transform_point3(p));
+                (inst.normal_to_world * local).normalize()
+            }
+        }
+    }
+
+    fn bounds(&self) -> Aabb {
+        match self {
+            Prim::Sphere { center, radius } => Aabb::new(
+                Vec3A::from(*center - *radius),
+                Vec3A::from(*center + *radius),
+            ),
+            Prim::Quad {
+                corner,
+                edge_u,
+                edge_v,
+            } => Aabb::from_points(&[
+                (*corner).into(),
+                (*corner + *edge_u).into(),
+                (*corner + *edge_v).into(),
+                (*corner + *edge_u + *edge_v).into(),
+            ]),
+            Prim::Box { min, max } => Aabb::new((*min).into(), (*max).into()),
+            Prim::Triangle { v0, e1, e2 } => {
+                Aabb::from_points(&[(*v0).into(), (*v0 + *e1).into(), (*v0 + *e2).into()])
+            }
+            Prim::Instance(inst) => inst.bounds,
+        }
+    }
+}
+
+impl Boundable for Record {
+    fn aabb(&self) -> Aabb {
+        self.prim.bounds()
+    }
+}
+
+/// What a ray hit: its distance and which primitive.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Hit {
+    pub t: f32,
+    id: u32,
+}
+
+/// The local geometry at a hit point.
+#[derive(Clone, Copy, Debug)]
+pub struct SurfaceHit {
+    pub p: Vec3,
+    /// Outward geometric unit normal (for quads and planes: the normal they
+    /// were given; for meshes: the winding's).
+    pub n: Vec3,
+    pub material: u32,
+    /// The light this surface belongs to, if it is an area light's surface.
+    pub emitter: Option<u32>,
+}
+
+/// All of a scene's surfaces, ready for ray queries.
+#[derive(Default)]
+pub struct Geometry {
+    records: Vec<Record>,
+    planes: Vec<PlaneRecord>,
+    bvh: Option<CwBvh>,
+}
+
+impl std::fmt::Debug for Geometry {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Geometry")
+            .field("primitives", &self.records.len())
+            .field("planes", &self.planes.len())
+            .finish()
+    }
+}
+
+/// Collects shapes; `build` makes the BVH.
+#[derive(Default)]
+pub struct GeometryBuilder {
+    records: Vec<Record>,
+    planes: Vec<PlaneRecord>,
+}
+
+impl GeometryBuilder {
+    /// Adds a shape with a material index and, for area lights, the index of
+    /// the light it is the surface of.
+    pub fn add(&mut self, shape: &Shape, material: u32, emitter: Option<u32>) {
+        let mut push = |prim| {
+            self.records.push(Record {
+                prim,
+                material,
+                emitter,
+            })
+        };
+        match shape {
+            Shape::Sphere { center, radius } => push(Prim::Sphere {
+                center: *center,
+                radius: *radius,
+            }),
+            Shape::Quad {
+                corner,
+                edge_u,
+                edge_v,
+            } => push(Prim::Quad {
+                corner: *corner,
+                edge_u: *edge_u,
+                edge_v: *edge_v,
+            }),
+            Shape::Box { min, max } => push(Prim::Box {
+                min: *min,
+                max: *max,
+            }),
+            Shape::Mesh {
+                positions,
+                triangles,
+            } => {
+                for tri in triangles {
+                    let [a, b, c] = tri.map(|i| positions[i as usize]);
+                    push(Prim::Triangle {
+                        v0: a,
+                        e1: b - a,
+                        e2: c - a,
+                    });
+                }
+            }
+            Shape::Transformed {
+                shape,
+                world_from_local,
+            } => {
+                let prim = match shape.as_ref() {
+                    Shape::Sphere { center, radius } => Prim::Sphere {
+                        center: *center,
+                        radius: *radius,
+                    },
+                    Shape::Box { min, max } => Prim::Box {
+                        min: *min,
+                        max: *max,
+                    },
+                    // Other shapes are baked by Shape::transformed.
+                    other => {
+                        let baked = other.clone().transformed(*world_from_local);
+                        return self.add(&baked, material, emitter);
+                    }
+                };
+                let local = prim.bounds();
+                let mut bounds = Aabb::empty();
+                for i in 0..8 {
+                    let corner = Vec3A::new(
+                        if i & 1 == 0 { local.min.x } else { local.max.x },
+                        if i & 2 == 0 { local.min.y } else { local.max.y },
+                        if i & 4 == 0 { local.min.z } else { local.max.z },
+                    );
+                    bounds.extend(world_from_local.transform_point3a(corner));
+                }
+                let linear = Mat3::from(world_from_local.matrix3);
+                push(Prim::Instance(std::boxed::Box::new(Instance {
+                    prim,
+                    local_from_world: world_from_local.inverse(),
+                    normal_to_world: linear.inverse().transpose(),
+                    bounds,
+                })))
+            }
+            Shape::Plane { point, normal } => self.planes.push(PlaneRecord {
+                point: *point,
+                normal: *normal,
+                material,
+            }),
+        }
+    }
+
+    /// Builds the BVH and lays the primitives out in its order.
+    pub fn build(self) -> Geometry {
+        let GeometryBuilder { records, planes } = self;
+        if records.is_empty() {
+            return Geometry {
+                records,
+                planes,
+                bvh: None,
+            };
+        }
+        let mut bvh = obvhs::cwbvh::builder::build_cwbvh(
+            &records,
+            BvhBuildParams::medium_build(),
+            &mut Duration::default(),
+        );
+        // Reorder so that the BVH's primitive ids index `records` directly.
+        let ordered: Vec<Record> = bvh
+            .primitive_indices
+            .iter()
+            .map(|&i| records[i as usize].clone())
+            .collect();
+        for (i, index) in bvh.primitive_indices.iter_mut().enumerate() {
+            *index = i as u32;
+        }
+        Geometry {
+            records: ordered,
+            planes,
+            bvh: Some(bvh),
+        }
+    }
+}
+
+impl Geometry {
+    /// Number of bounded primitives (triangles count one each) and planes.
+    pub fn primitive_count(&self) -> (usize, usize) {
+        (self.records.len(), self.planes.len())
+    }
+
+    /// Bounds of everything but the infinite planes, or None if there is nothing.
+    pub fn bounds(&self) -> Option<(Vec3, Vec3)> {
+        self.bvh
+            .as_ref()
+            .map(|b| (Vec3::from(b.total_aabb.min), Vec3::from(b.total_aabb.max)))
+    }
+
+    /// The nearest hit with 0 < t < tmax.
+    pub fn intersect(&self, ray: &Ray, tmax: f32) -> Option<Hit> {
+        let mut best = Hit {
+            t: tmax,
+            id: u32::MAX,
+        };
+        if let Some(bvh) = &self.bvh {
+            let r = obvhs::ray::Ray::new(ray.origin.into(), ray.dir.into(), 0.0, tmax);
+            let mut hit = obvhs::ray::RayHit::none();
+            if bvh.ray_traverse(r, &mut hit, |r, id| {
+                self.records[id]
+                    .prim
+                    .intersect(ray.origin, ray.dir, 0.0, r.tmax)
+            }) {
+                best = Hit {
+                    t: hit.t,
+                    id: hit.primitive_id,
+                };
+            }
+        }
+        let base = self.records.len() as u32;
+        for (i, plane) in self.planes.iter().enumerate() {
+            let t = intersect_plane(plane, ray.origin, ray.dir);
+            if t > 0.0 && t < best.t {
+                best = Hit {
+                    t,
+                    id: base + i as u32,
+                };
+            }
+        }
+        (best.id != u32::MAX).then_some(best)
+    }
+
+    /// Whether anything lies on the open segment `origin + t·dir`, 0 < t < tmax.
+    pub fn occluded(&self, origin: Vec3, dir: Vec3, tmax: f32) -> bool {
+        for plane in &self.planes {
+            let t = intersect_plane(plane, origin, dir);
+            if t > 0.0 && t < tmax {
+                return true;
+            }
+        }
+        match &self.bvh {
+            Some(bvh) => {
+                let r = obvhs::ray::Ray::new(origin.into(), dir.into(), 0.0, tmax);
+                !bvh.ray_traverse_miss(r, |r, id| {
+                    self.records[id].prim.intersect(origin, dir, 0.0, r.tmax)
+                })
+            }
+            None => false,
+        }
+    }
+
+    /// The nearest hit found by testing every primitive: the oracle that the
+    /// BVH is tested against.
+    pub fn intersect_brute_force(&self, ray: &Ray, tmax: f32) -> Option<Hit> {
+        let mut best = Hit {
+            t: tmax,
+            id: u32::MAX,
+        };
+        for (i, rec) in self.records.iter().enumerate() {
+            let t = rec.prim.intersect(ray.origin, ray.dir, 0.0, best.t);
+            if t < best.t {
+                best = Hit { t, id: i as u32 };
+            }
+        }
+        let base = self.records.len() as u32;
+        for (i, plane) in self.planes.iter().enumerate() {
+            let t = intersect_plane(plane, ray.origin, ray.dir);
+            if t > 0.0 && t < best.t {
+                best = Hit {
+                    t,
+                    id: base + i as u32,
+                };
+            }
+        }
+        (best.id != u32::MAX).then_some(best)
+    }
+
+    /// The surface at a hit of `ray`.
+    pub fn surface(&self, ray: &Ray, hit: Hit) -> SurfaceHit {
+        let p = ray.at(hit.t);
+        let index = hit.id as usize;
+        match self.records.get(index) {
+            Some(rec) => SurfaceHit {
+                p,
+                n: rec.prim.normal(p),
+                material: rec.material,
+                emitter: rec.emitter,
+            },
+            None => {
+                let plane = &self.planes[index - self.records.len()];
+                SurfaceHit {
+                    p,
+                    n: plane.normal,
+                    material: plane.material,
+                    emitter: None,
+                }
+            }
+        }
+    }
+}
+
+#[inline]
+fn intersect_plane(plane: &PlaneRecord, o: Vec3, d: Vec3) -> f32 {
+    let denom = plane.normal.dot(d);
+    if denom.abs() < 1e-20 {
+        return f32::INFINITY;
+    }
+    plane.normal.dot(plane.point - o) / denom
+}

@@ -1,0 +1,9 @@
+//! Rays, shapes and the acceleration structure that finds what a ray hits.
+
+mod accel;
+mod ray;
+mod shape;
+
+pub use accel::{Geometry, GeometryBuilder, Hit, SurfaceHit};
+pub use ray::{Ray, offset_origin};
+pub use shape::{Shape, intersect_box, intersect_quad, intersect_sphere, intersect_triangle};

@@ -1,0 +1,54 @@
+//! Airlight: a CPU renderer for light that you can see.
+//!
+//! The library holds the render-time scene ([`Scene`]), its description as read
+//! from TOML ([`scene::SceneDesc`]), geometry with a BVH, lights, participating
+//! media, cameras and the integrators. It knows nothing of terminals: the
+//! `airlight` command is a thin shell around it.
+//!
+//! ```
+//! use airlight::prelude::*;
+//! let scene = SceneBuilder::new()
+//!     .size(32, 24)
+//!     .camera(Camera::look_at(vec3(0.0, 1.0, -5.0), vec3(0.0, 1.0, 0.0), Vec3::Y, 40.0))
+//!     .material("white", Material::diffuse(Rgb::splat(0.8)))
+//!     .object(Shape::sphere(vec3(0.0, 1.0, 0.0), 1.0), "white")
+//!     .light(Light::point(vec3(0.0, 4.0, -2.0), Rgb::splat(20.0)))
+//!     .build()
+//!     .unwrap();
+//! let image = airlight::render(&scene, &RenderObserver::none());
+//! assert!(image.pixel(16, 12).x > 0.0);
+//! ```
+
+pub mod camera;
+pub mod film;
+pub mod geometry;
+pub mod integrator;
+pub mod light;
+pub mod material;
+pub mod medium;
+pub mod render;
+pub mod sampling;
+pub mod scene;
+
+/// Linear RGB radiance, irradiance or reflectance.
+pub type Rgb = glam::Vec3;
+
+pub use camera::Camera;
+pub use film::Image;
+pub use render::{RenderObserver, render};
+pub use scene::{Scene, SceneBuilder};
+
+/// The names most programs need.
+pub mod prelude {
+    pub use crate::Rgb;
+    pub use crate::camera::Camera;
+    pub use crate::film::Image;
+    pub use crate::geometry::Shape;
+    pub use crate::integrator::IntegratorKind;
+    pub use crate::light::Light;
+    pub use crate::material::Material;
+    pub use crate::medium::Medium;
+    pub use crate::render::{RenderObserver, render};
+    pub use crate::scene::{Scene, SceneBuilder};
+    pub use glam::{Vec3, vec3};
+}

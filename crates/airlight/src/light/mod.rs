@@ -1,0 +1,260 @@
+//! Lights, in the units of DESIGN.md: point and spot `intensity` in W/sr,
+//! distant `irradiance` on a facing surface, sphere and quad `radiance`.
+
+mod spot;
+
+pub use spot::{SpotProfile, spot_falloff};
+
+use crate::Rgb;
+use crate::sampling::{basis, uniform_cone};
+use glam::{Vec2, Vec3};
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Light {
+    Point {
+        position: Vec3,
+        intensity: Rgb,
+    },
+    Spot {
+        position: Vec3,
+        /// Unit axis of the cone.
+        direction: Vec3,
+        intensity: Rgb,
+        /// Half angle of the cone, radians.
+        cone_angle: f32,
+        /// Half angle where the falloff begins, radians.
+        falloff_start: f32,
+        profile: SpotProfile,
+    },
+    /// A sun: parallel light travelling along the unit vector `direction`.
+    Distant {
+        direction: Vec3,
+        irradiance: Rgb,
+    },
+    Sphere {
+        center: Vec3,
+        radius: f32,
+        radiance: Rgb,
+    },
+    /// Emits on the side of normalize(edge_u × edge_v) only.
+    Quad {
+        corner: Vec3,
+        edge_u: Vec3,
+        edge_v: Vec3,
+        radiance: Rgb,
+    },
+}
+
+/// Light arriving at a point from one sampled direction.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LightSample {
+    /// Unit direction from the point toward the light.
+    pub wi: Vec3,
+    /// Distance to the sampled point of the light (infinite for a sun).
+    pub distance: f32,
+    /// Incident radiance divided by the solid-angle pdf; for delta lights,
+    /// the irradiance on a surface facing the light (I/d² for a point).
+    /// Multiply by BRDF·|cos| (or phase) for the direct-light estimate.
+    pub weight: Rgb,
+    /// Solid-angle pdf of `wi`; 0 for delta lights.
+    pub pdf: f32,
+}
+
+impl Light {
+    pub fn point(position: Vec3, intensity: Rgb) -> Self {
+        Light::Point {
+            position,
+            intensity,
+        }
+    }
+
+    /// A spot light; angles in degrees, profile smoothstep.
+    pub fn spot(
+        position: Vec3,
+        target: Vec3,
+        intensity: Rgb,
+        cone_deg: f32,
+        falloff_start_deg: f32,
+    ) -> Self {
+        Light::Spot {
+            position,
+            direction: (target - position).normalize(),
+            intensity,
+            cone_angle: cone_deg.to_radians(),
+            falloff_start: falloff_start_deg.to_radians(),
+            profile: SpotProfile::Smoothstep,
+        }
+    }
+
+    pub fn distant(direction: Vec3, irradiance: Rgb) -> Self {
+        Light::Distant {
+            direction: direction.normalize(),
+            irradiance,
+        }
+    }
+
+    pub fn sphere(center: Vec3, radius: f32, radiance: Rgb) -> Self {
+        Light::Sphere {
+            center,
+            radius,
+            radiance,
+        }
+    }
+
+    pub fn quad(corner: Vec3, edge_u: Vec3, edge_v: Vec3, radiance: Rgb) -> Self {
+        Light::Quad {
+            corner,
+            edge_u,
+            edge_v,
+            radiance,
+        }
+    }
+
+    /// Whether the light is a point or direction (no area to hit or sample).
+    pub fn is_delta(&self) -> bool {
+        matches!(
+            self,
+            Light::Point { .. } | Light::Spot { .. } | Light::Distant { .. }
+        )
+    }
+
+    /// Samples light arriving at `p`; `u` uniform in [0, 1)². None when no light
+    /// arrives from the sample (outside a spot's cone, behind a quad light).
+    pub fn sample(&self, p: Vec3, u: Vec2) -> Option<LightSample> {
+        match *self {
+            Light::Point {
+                position,
+                intensity,
+            } => {
+                let to = position - p;
+                let d2 = to.length_squared();
+                let distance = d2.sqrt();
+                Some(LightSample {
+                    wi: to / distance,
+                    distance,
+                    weight: intensity / d2,
+                    pdf: 0.0,
+                })
+            }
+            Light::Spot {
+                position,
+                direction,
+                intensity,
+                cone_angle,
+                falloff_start,
+                profile,
+            } => {
+                let to = position - p;
+                let d2 = to.length_squared();
+                let distance = d2.sqrt();
+                let wi = to / distance;
+                let falloff = spot_falloff(profile, -wi.dot(direction), cone_angle, falloff_start);
+                (falloff > 0.0).then(|| LightSample {
+                    wi,
+                    distance,
+                    weight: intensity * (falloff / d2),
+                    pdf: 0.0,
+                })
+            }
+            Light::Distant {
+                direction,
+                irradiance,
+            } => Some(LightSample {
+                wi: -direction,
+                distance: f32::INFINITY,
+                weight: irradiance,
+                pdf: 0.0,
+            }),
+            Light::Sphere {
+                center,
+                radius,
+                radiance,
+            } => sample_sphere(center, radius, radiance, p, u),
+            Light::Quad {
+                corner,
+                edge_u,
+                edge_v,
+                radiance,
+            } => {
+                let x = corner + edge_u * u.x + edge_v * u.y;
+                let to = x - p;
+                let d2 = to.length_squared();
+                let distance = d2.sqrt();
+                let wi = to / distance;
+                let normal_area = edge_u.cross(edge_v);
+                let area = normal_area.length();
+                let cos_light = -wi.dot(normal_area) / area;
+                if cos_light <= 0.0 || d2 == 0.0 {
+                    return None;
+                }
+                let pdf = d2 / (area * cos_light);
+                Some(LightSample {
+                    wi,
+                    distance,
+                    weight: radiance / pdf,
+                    pdf,
+                })
+            }
+        }
+    }
+
+    /// Radiance leaving the light's surface toward `-dir` at a point whose
+    /// outward normal is `n` (area lights; zero for others).
+    pub fn emitted(&self, n: Vec3, dir: Vec3) -> Rgb {
+        match *self {
+            Light::Sphere { radiance, .. } => radiance,
+            Light::Quad { radiance, .. } if n.dot(dir) < 0.0 => radiance,
+            _ => Rgb::ZERO,
+        }
+    }
+}
+
+/// Samples a sphere light over the cone of directions it subtends from `p`
+/// (pbrt-v4, Sphere::Sample with a reference point): uniform in that cone,
+/// pdf = 1/(2π(1 − cos θmax)). From inside the sphere, directions are uniform
+/// over the whole sphere of directions.
+fn sample_sphere(
+    center: Vec3,
+    radius: f32,
+    radiance: Rgb,
+    p: Vec3,
+    u: Vec2,
+) -> Option<LightSample> {
+    let to_center = center - p;
+    let dc2 = to_center.length_squared();
+    let r2 = radius * radius;
+    let axis;
+    // 1 − cos θmax, accurate also for small cones: sin²θmax / (1 + cos θmax).
+    let one_minus_cos;
+    if dc2 <= r2 {
+        axis = Vec3::Z;
+        one_minus_cos = 2.0;
+    } else {
+        axis = to_center / dc2.sqrt();
+        let sin2 = r2 / dc2;
+        let cos_max = (1.0 - sin2).max(0.0).sqrt();
+        one_minus_cos = sin2 / (1.0 + cos_max);
+    }
+    let local = uniform_cone(u, 1.0 - one_minus_cos);
+    let (t, b) = basis(axis);
+    let wi = (t * local.x + b * local.y + axis * local.z).normalize();
+    // Distance to the sphere's near surface along wi (the far one from inside).
+    let along = to_center.dot(wi);
+    let closest2 = (dc2 - along * along).max(0.0);
+    let half_chord = (r2 - closest2).max(0.0).sqrt();
+    let distance = if dc2 <= r2 {
+        along + half_chord
+    } else {
+        (along - half_chord).max(0.0)
+    };
+    let pdf = 1.0 / (2.0 * std::f32::consts::PI * one_minus_cos);
+    Some(LightSample {
+        wi,
+        distance,
+        weight: radiance / pdf,
+        pdf,
+    })
+}
+
+#[cfg(test)]
+mod tests;

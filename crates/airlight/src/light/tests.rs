@@ -1,0 +1,128 @@
+use super::*;
+use std::f64::consts::PI;
+
+/// Irradiance at the origin (normal +y) from a uniformly emitting polygon, by
+/// Lambert's closed form: E = L/2 · |Σ θ_i (n · unit(v_i × v_{i+1}))|, v_i the
+/// unit vectors to the vertices and θ_i the angle between consecutive ones.
+fn polygon_irradiance(vertices: &[glam::DVec3], radiance: f64, n: glam::DVec3) -> f64 {
+    let mut sum = 0.0;
+    for i in 0..vertices.len() {
+        let a = vertices[i].normalize();
+        let b = vertices[(i + 1) % vertices.len()].normalize();
+        let theta = a.dot(b).clamp(-1.0, 1.0).acos();
+        sum += theta * n.dot(a.cross(b).normalize());
+    }
+    0.5 * radiance * sum.abs()
+}
+
+/// Irradiance on a surface with normal `n` at `p`, from a stratified grid of
+/// k×k light samples (unshadowed).
+fn estimated_irradiance(light: &Light, p: Vec3, n: Vec3, k: usize) -> f64 {
+    let mut sum = 0.0f64;
+    for i in 0..k {
+        for j in 0..k {
+            let u = Vec2::new((i as f32 + 0.5) / k as f32, (j as f32 + 0.5) / k as f32);
+            if let Some(s) = light.sample(p, u) {
+                sum += (s.weight.x * s.wi.dot(n).max(0.0)) as f64;
+            }
+        }
+    }
+    sum / (k * k) as f64
+}
+
+#[test]
+fn quad_light_irradiance_matches_lambert_closed_form() {
+    // A 2×1 light, 1.5 above a point and offset, facing down.
+    let corner = Vec3::new(-0.3, 1.5, -0.4);
+    let (eu, ev) = (Vec3::new(0.0, 0.0, 1.0), Vec3::new(2.0, 0.0, 0.0));
+    assert!(eu.cross(ev).y < 0.0, "faces down");
+    let light = Light::quad(corner, eu, ev, Rgb::splat(3.0));
+    let verts: Vec<glam::DVec3> = [corner, corner + eu, corner + eu + ev, corner + ev]
+        .iter()
+        .map(|v| v.as_dvec3())
+        .collect();
+    let exact = polygon_irradiance(&verts, 3.0, glam::DVec3::Y);
+    // 1024 samples, as the issue asks.
+    let est = estimated_irradiance(&light, Vec3::ZERO, Vec3::Y, 32);
+    assert!(
+        (est / exact - 1.0).abs() < 0.01,
+        "estimate {est} exact {exact}"
+    );
+    // From above, the light's back faces the point: no light.
+    assert_eq!(
+        estimated_irradiance(&light, Vec3::new(0.5, 3.0, 0.1), -Vec3::Y, 4),
+        0.0
+    );
+}
+
+#[test]
+fn sphere_light_irradiance_matches_closed_form() {
+    // E = π L (r/D)² on a point facing the sphere's centre at distance D.
+    for (radius, dist) in [(0.5f32, 3.0f32), (1.0, 1.2), (0.05, 10.0)] {
+        let light = Light::sphere(Vec3::new(0.0, dist, 0.0), radius, Rgb::splat(2.0));
+        let exact = PI * 2.0 * (radius as f64 / dist as f64).powi(2);
+        let est = estimated_irradiance(&light, Vec3::ZERO, Vec3::Y, 64);
+        assert!(
+            (est / exact - 1.0).abs() < 0.005,
+            "r {radius} D {dist}: {est} vs {exact}"
+        );
+    }
+}
+
+#[test]
+fn sphere_light_samples_land_on_the_sphere() {
+    let c = Vec3::new(1.0, 2.0, 3.0);
+    let light = Light::sphere(c, 0.7, Rgb::ONE);
+    let p = Vec3::new(-1.0, 0.5, 0.0);
+    for i in 0..100 {
+        let u = Vec2::new((i as f32 * 0.618) % 1.0, (i as f32 * 0.377) % 1.0);
+        let s = light.sample(p, u).unwrap();
+        let x = p + s.wi * s.distance;
+        assert!(((x - c).length() - 0.7).abs() < 1e-4);
+        assert!((x - c).dot(s.wi) <= 1e-4, "the near side");
+    }
+}
+
+#[test]
+fn point_light_gives_inverse_square_irradiance() {
+    let light = Light::point(Vec3::new(0.0, 2.0, 0.0), Rgb::splat(8.0));
+    let s = light.sample(Vec3::ZERO, Vec2::ZERO).unwrap();
+    assert_eq!(s.weight, Rgb::splat(2.0));
+    assert_eq!(s.wi, Vec3::Y);
+}
+
+#[test]
+fn spot_profiles_match_their_definitions() {
+    let (cone, start) = (30f32.to_radians(), 20f32.to_radians());
+    for profile in [SpotProfile::Smoothstep, SpotProfile::Linear] {
+        assert_eq!(spot_falloff(profile, 1.0, cone, start), 1.0);
+        assert_eq!(
+            spot_falloff(profile, 19f32.to_radians().cos(), cone, start),
+            1.0
+        );
+        assert_eq!(
+            spot_falloff(profile, 31f32.to_radians().cos(), cone, start),
+            0.0
+        );
+    }
+    // Linear: half-way in angle gives one half.
+    let mid = spot_falloff(SpotProfile::Linear, 25f32.to_radians().cos(), cone, start);
+    assert!((mid - 0.5).abs() < 1e-4);
+    // Smoothstep: half-way in cosine gives one half.
+    let mid_cos = 0.5 * (cone.cos() + start.cos());
+    assert!((spot_falloff(SpotProfile::Smoothstep, mid_cos, cone, start) - 0.5).abs() < 1e-4);
+    // Equal angles: a hard edge.
+    assert_eq!(
+        spot_falloff(
+            SpotProfile::Smoothstep,
+            29.9f32.to_radians().cos(),
+            cone,
+            cone
+        ),
+        1.0
+    );
+    assert_eq!(
+        spot_falloff(SpotProfile::Linear, 30.1f32.to_radians().cos(), cone, cone),
+        0.0
+    );
+}

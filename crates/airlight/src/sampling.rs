@@ -1,0 +1,133 @@
+//! Random numbers and the warps that turn them into directions and points.
+//!
+//! Every pixel draws from its own generator, seeded from (scene seed, pixel,
+//! pass) by a hash, so an image does not depend on which thread rendered what.
+
+use glam::{Vec2, Vec3};
+use rand::{RngExt, SeedableRng};
+use rand_pcg::Pcg32;
+use std::f32::consts::PI;
+
+/// A per-pixel stream of uniform numbers in [0, 1).
+pub struct Sampler {
+    rng: Pcg32,
+}
+
+/// SplitMix64's finaliser (Steele, Lea and Flood 2014): a bijective 64-bit mix.
+fn mix64(mut z: u64) -> u64 {
+    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+    z ^ (z >> 31)
+}
+
+impl Sampler {
+    /// The generator of one pixel in one pass of a render with this seed.
+    pub fn for_pixel(seed: u64, pixel: u64, pass: u64) -> Self {
+        let key = mix64(mix64(mix64(seed) ^ pixel) ^ pass.wrapping_mul(0x9e37_79b9_7f4a_7c15));
+        Self {
+            rng: Pcg32::seed_from_u64(key),
+        }
+    }
+
+    #[inline]
+    pub fn next(&mut self) -> f32 {
+        self.rng.random::<f32>()
+    }
+
+    #[inline]
+    pub fn next2(&mut self) -> Vec2 {
+        Vec2::new(self.next(), self.next())
+    }
+}
+
+/// An orthonormal basis (t, b, n) around a unit vector n, by the branchless
+/// construction of Duff et al., "Building an Orthonormal Basis, Revisited"
+/// (JCGT 2017).
+#[inline]
+pub fn basis(n: Vec3) -> (Vec3, Vec3) {
+    let sign = 1.0f32.copysign(n.z);
+    let a = -1.0 / (sign + n.z);
+    let b = n.x * n.y * a;
+    (
+        Vec3::new(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x),
+        Vec3::new(b, sign + n.y * n.y * a, -n.y),
+    )
+}
+
+/// Expresses local (x, y, z) in the frame whose z axis is `n`.
+#[inline]
+pub fn to_world(local: Vec3, n: Vec3) -> Vec3 {
+    let (t, b) = basis(n);
+    t * local.x + b * local.y + n * local.z
+}
+
+/// A point on the unit disk, by Shirley and Chiu's concentric map (1997).
+pub fn concentric_disk(u: Vec2) -> Vec2 {
+    let o = u * 2.0 - Vec2::ONE;
+    if o == Vec2::ZERO {
+        return Vec2::ZERO;
+    }
+    let (r, theta) = if o.x.abs() > o.y.abs() {
+        (o.x, PI / 4.0 * (o.y / o.x))
+    } else {
+        (o.y, PI / 2.0 - PI / 4.0 * (o.x / o.y))
+    };
+    Vec2::new(r * theta.cos(), r * theta.sin())
+}
+
+/// A direction uniformly inside the cone of half angle θmax around +z, given
+/// cos θmax; pdf = 1 / (2π (1 − cos θmax)).
+pub fn uniform_cone(u: Vec2, cos_theta_max: f32) -> Vec3 {
+    let cos_theta = (1.0 - u.x) + u.x * cos_theta_max;
+    let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
+    let phi = 2.0 * PI * u.y;
+    Vec3::new(sin_theta * phi.cos(), sin_theta * phi.sin(), cos_theta)
+}
+
+/// A direction uniformly on the unit sphere; pdf = 1/(4π).
+pub fn uniform_sphere(u: Vec2) -> Vec3 {
+    let z = 1.0 - 2.0 * u.x;
+    let r = (1.0 - z * z).max(0.0).sqrt();
+    let phi = 2.0 * PI * u.y;
+    Vec3::new(r * phi.cos(), r * phi.sin(), z)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn basis_is_orthonormal() {
+        let mut s = Sampler::for_pixel(1, 2, 3);
+        for _ in 0..1000 {
+            let n = uniform_sphere(s.next2());
+            let (t, b) = basis(n);
+            for (x, y) in [(t, b), (t, n), (b, n)] {
+                assert!(x.dot(y).abs() < 1e-5);
+            }
+            for v in [t, b] {
+                assert!((v.length() - 1.0).abs() < 1e-5);
+            }
+            assert!((t.cross(b) - n).length() < 1e-4, "right-handed");
+        }
+    }
+
+    #[test]
+    fn cone_samples_stay_in_cone_and_cover_it_uniformly() {
+        // The fraction of samples with cos θ above the cone's mid-cosine must
+        // be the solid-angle fraction, 1/2 (cos θ is uniform in the cone).
+        let cos_max = 0.8f32;
+        let mid = 0.5 * (1.0 + cos_max);
+        let mut s = Sampler::for_pixel(7, 0, 0);
+        let n = 100_000;
+        let mut above = 0;
+        for _ in 0..n {
+            let d = uniform_cone(s.next2(), cos_max);
+            assert!(d.z >= cos_max - 1e-6);
+            assert!((d.length() - 1.0).abs() < 1e-5);
+            above += (d.z > mid) as usize;
+        }
+        let frac = above as f64 / n as f64;
+        assert!((frac - 0.5).abs() < 0.005, "{frac}");
+    }
+}

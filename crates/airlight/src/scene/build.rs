@@ -1,0 +1,701 @@
+//! From a scene file to a [`Scene`]: parse, check every value, load meshes.
+//! Each error names the place in the file and what was expected.
+
+use super::desc::*;
+use super::{RenderSettings, Scene, SceneBuilder, SceneError, default_camera};
+use crate::Rgb;
+use crate::camera::{Camera, Projection};
+use crate::geometry::Shape;
+use crate::integrator::IntegratorKind;
+use crate::light::{Light, SpotProfile};
+use crate::material::Material;
+use crate::medium::Medium;
+use glam::{Affine3A, Quat, Vec3};
+use std::ops::Range;
+use std::path::Path;
+use toml::Spanned;
+
+/// Reads and builds the scene file at `path`; meshes are found relative to it.
+pub fn load(path: &Path) -> Result<Scene, SceneError> {
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| SceneError::new(format!("cannot read the scene file: {e}")).in_file(path))?;
+    from_toml_str(&text, path.parent()).map_err(|e| e.in_file(path))
+}
+
+/// Builds a scene from TOML text. `base_dir` is where relative mesh paths
+/// start (None: the current directory).
+pub fn from_toml_str(text: &str, base_dir: Option<&Path>) -> Result<Scene, SceneError> {
+    let desc: SceneDesc = toml::from_str(text).map_err(|e| {
+        let message = e.message().trim_end().to_string();
+        match e.span() {
+            Some(span) => SceneError::at(text, span.start, message),
+            None => SceneError::new(message),
+        }
+    })?;
+    Checker { text, base_dir }.scene(desc)
+}
+
+struct Checker<'a> {
+    text: &'a str,
+    base_dir: Option<&'a Path>,
+}
+
+type Result<T, E = SceneError> = std::result::Result<T, E>;
+
+impl Checker<'_> {
+    fn err(&self, span: Range<usize>, message: impl Into<String>) -> SceneError {
+        SceneError::at(self.text, span.start, message)
+    }
+
+    fn scene(&self, desc: SceneDesc) -> Result<Scene> {
+        let settings = self.settings(&desc)?;
+        let mut builder = SceneBuilder::new().settings(settings);
+        if let Some(camera) = &desc.camera {
+            builder = builder.camera(self.camera(camera)?);
+        }
+        if let Some(medium) = &desc.medium {
+            builder = builder.medium(self.medium(medium)?);
+        }
+        for (name, material) in &desc.materials {
+            builder = builder.material(name, self.material(name, material)?);
+        }
+        for (i, object) in desc.objects.iter().enumerate() {
+            let (shape, material) = self.object(i, object, &desc)?;
+            builder = builder.object(shape, &material);
+        }
+        for (i, light) in desc.lights.iter().enumerate() {
+            builder = builder.light(self.light(i, light)?);
+        }
+        builder.build()
+    }
+
+    fn settings(&self, desc: &SceneDesc) -> Result<RenderSettings> {
+        let r = &desc.render;
+        let mut s = RenderSettings::default();
+        // With fog and no integrator named, show the fog.
+        if desc.medium.is_some() {
+            s.integrator = IntegratorKind::Raymarch;
+        }
+        let count = |v: &Option<Spanned<i64>>, name: &str, min: i64, default: u32| -> Result<u32> {
+            match v {
+                None => Ok(default),
+                Some(v) if *v.get_ref() >= min && *v.get_ref() <= u32::MAX as i64 => {
+                    Ok(*v.get_ref() as u32)
+                }
+                Some(v) => Err(self.err(
+                    v.span(),
+                    format!(
+                        "render.{name} must be an integer ≥ {min}, got {}",
+                        v.get_ref()
+                    ),
+                )),
+            }
+        };
+        s.width = count(&r.width, "width", 1, s.width)?;
+        s.height = count(&r.height, "height", 1, s.height)?;
+        s.spp = count(&r.spp, "spp", 1, s.spp)?;
+        s.steps = count(&r.steps, "steps", 1, s.steps)?;
+        s.max_depth = count(&r.max_depth, "max_depth", 1, s.max_depth)?;
+        if let Some(seed) = &r.seed {
+            s.seed = *seed.get_ref() as u64;
+        }
+        if let Some(integrator) = r.integrator {
+            s.integrator = integrator;
+        }
+        if let Some(d) = &r.max_distance {
+            s.max_distance = self.positive(d.span(), "render.max_distance", *d.get_ref())?;
+        }
+        if let Some(b) = &r.background {
+            s.background = self.non_negative3(b.span(), "render.background", b.get_ref().0)?;
+        }
+        if let Some(e) = &r.exposure {
+            s.exposure = self.finite(e.span(), "render.exposure", *e.get_ref())?;
+        }
+        if let Some(t) = r.tonemap {
+            s.tonemap = t;
+        }
+        if let Some(j) = r.jitter {
+            s.jitter = j;
+        }
+        Ok(s)
+    }
+
+    fn finite(&self, span: Range<usize>, what: &str, v: f32) -> Result<f32> {
+        if v.is_finite() {
+            Ok(v)
+        } else {
+            Err(self.err(span, format!("{what} must be a finite number, got {v}")))
+        }
+    }
+
+    fn positive(&self, span: Range<usize>, what: &str, v: f32) -> Result<f32> {
+        if v.is_finite() && v > 0.0 {
+            Ok(v)
+        } else {
+            Err(self.err(
+                span,
+                format!("{what} must be a positive finite number, got {v}"),
+            ))
+        }
+    }
+
+    fn non_negative(&self, span: Range<usize>, what: &str, v: f32) -> Result<f32> {
+        if v.is_finite() && v >= 0.0 {
+            Ok(v)
+        } else {
+            Err(self.err(span, format!("{what} must be a finite number ≥ 0, got {v}")))
+        }
+    }
+
+    fn finite3(&self, span: Range<usize>, what: &str, v: Vec3) -> Result<Vec3> {
+        if v.is_finite() {
+            Ok(v)
+        } else {
+            Err(self.err(span, format!("{what} must be finite, got {v}")))
+        }
+    }
+
+    fn non_negative3(&self, span: Range<usize>, what: &str, v: Vec3) -> Result<Vec3> {
+        if v.is_finite() && v.min_element() >= 0.0 {
+            Ok(v)
+        } else {
+            Err(self.err(span, format!("{what} must be finite and ≥ 0, got {v}")))
+        }
+    }
+
+    fn nonzero3(&self, span: Range<usize>, what: &str, v: Vec3) -> Result<Vec3> {
+        let v = self.finite3(span.clone(), what, v)?;
+        if v.length_squared() > 0.0 {
+            Ok(v)
+        } else {
+            Err(self.err(span, format!("{what} must not be zero")))
+        }
+    }
+
+    fn camera(&self, desc: &Spanned<CameraDesc>) -> Result<Camera> {
+        let span = desc.span();
+        let c = desc.get_ref();
+        let point = |v: Option<Point>, name: &str, default: Vec3| -> Result<Vec3> {
+            self.finite3(
+                span.clone(),
+                &format!("camera.{name}"),
+                v.map_or(default, |p| p.0),
+            )
+        };
+        let default = default_camera();
+        let look_at = point(c.look_at, "look_at", Vec3::new(0.0, 1.0, 0.0))?;
+        let up = self.nonzero3(span.clone(), "camera.up", c.up.map_or(Vec3::Y, |p| p.0))?;
+        let position = match c.kind {
+            CameraType::Isometric => {
+                if c.position.is_some() {
+                    return Err(self.err(
+                        span,
+                        "an isometric camera is placed by look_at and distance, not position",
+                    ));
+                }
+                let distance =
+                    self.positive(span.clone(), "camera.distance", c.distance.unwrap_or(50.0))?;
+                look_at - crate::camera::ISOMETRIC_VIEW * distance
+            }
+            _ => point(c.position, "position", default.position)?,
+        };
+        let forward = look_at - position;
+        if forward.length_squared() == 0.0 {
+            return Err(self.err(span, "camera.position and camera.look_at must differ"));
+        }
+        if forward.normalize().cross(up.normalize()).length() < 1e-6 {
+            return Err(self.err(span, "camera.up must not be parallel to the view direction"));
+        }
+        let projection = match c.kind {
+            CameraType::Perspective => {
+                if c.view_height.is_some() {
+                    return Err(self.err(
+                        span,
+                        "view_height is for orthographic cameras; a perspective camera takes fov",
+                    ));
+                }
+                let fov = c.fov.unwrap_or(40.0);
+                if !(fov > 0.0 && fov < 180.0) {
+                    return Err(self.err(
+                        span,
+                        format!("camera.fov must be between 0 and 180 degrees, got {fov}"),
+                    ));
+                }
+                Projection::Perspective { fov_degrees: fov }
+            }
+            CameraType::Orthographic | CameraType::Isometric => {
+                if c.fov.is_some() {
+                    return Err(self.err(
+                        span,
+                        "fov is for perspective cameras; an orthographic camera takes view_height",
+                    ));
+                }
+                let h = self.positive(
+                    span.clone(),
+                    "camera.view_height",
+                    c.view_height.unwrap_or(10.0),
+                )?;
+                Projection::Orthographic { view_height: h }
+            }
+        };
+        let aperture =
+            self.non_negative(span.clone(), "camera.aperture", c.aperture.unwrap_or(0.0))?;
+        let focus = c.focus_distance.unwrap_or(forward.length());
+        let focus = self.positive(span, "camera.focus_distance", focus)?;
+        Ok(Camera::oriented(position, look_at, up, projection).with_lens(aperture, focus))
+    }
+
+    fn medium(&self, desc: &Spanned<MediumDesc>) -> Result<Medium> {
+        let span = desc.span();
+        let m = desc.get_ref();
+        let sigma_a = self.non_negative3(
+            span.clone(),
+            "medium.sigma_a",
+            m.sigma_a.map_or(Vec3::ZERO, |t| t.0),
+        )?;
+        let sigma_s = self.non_negative3(
+            span.clone(),
+            "medium.sigma_s",
+            m.sigma_s.map_or(Vec3::ZERO, |t| t.0),
+        )?;
+        let g = m.g.unwrap_or(0.0);
+        if !(g > -1.0 && g < 1.0) {
+            return Err(self.err(
+                span,
+                format!("medium.g must lie strictly between -1 and 1, got {g}"),
+            ));
+        }
+        match m.kind {
+            MediumType::Homogeneous => {
+                if m.base.is_some() || m.falloff.is_some() {
+                    return Err(self.err(
+                        span,
+                        "base and falloff belong to a `height` medium, not a homogeneous one",
+                    ));
+                }
+                Ok(Medium::homogeneous(sigma_a, sigma_s, g))
+            }
+            MediumType::Height => {
+                let base = self.finite(span.clone(), "medium.base", m.base.unwrap_or(0.0))?;
+                let falloff =
+                    self.non_negative(span, "medium.falloff", m.falloff.unwrap_or(0.5))?;
+                Ok(Medium::height(sigma_a, sigma_s, g, base, falloff))
+            }
+        }
+    }
+
+    fn material(&self, name: &str, desc: &Spanned<MaterialDesc>) -> Result<Material> {
+        let span = desc.span();
+        let m = desc.get_ref();
+        let what = |field: &str| format!("materials.{name}.{field}");
+        let albedo = |t: Option<Triple>, field: &str, default: f32| -> Result<Rgb> {
+            self.non_negative3(
+                span.clone(),
+                &what(field),
+                t.map_or(Vec3::splat(default), |t| t.0),
+            )
+        };
+        let misplaced = |present: bool, field: &str, owner: &str| -> Result<()> {
+            if present {
+                Err(self.err(
+                    span.clone(),
+                    format!("{} belongs to a {owner} material", what(field)),
+                ))
+            } else {
+                Ok(())
+            }
+        };
+        if m.kind != MaterialType::Checker {
+            misplaced(m.albedo2.is_some(), "albedo2", "checker")?;
+            misplaced(m.scale.is_some(), "scale", "checker")?;
+        }
+        if m.kind != MaterialType::Phong {
+            misplaced(m.specular.is_some(), "specular", "phong")?;
+            misplaced(m.exponent.is_some(), "exponent", "phong")?;
+        }
+        let a = albedo(m.albedo, "albedo", 0.8)?;
+        Ok(match m.kind {
+            MaterialType::Diffuse => Material::diffuse(a),
+            MaterialType::Checker => {
+                let a2 = albedo(m.albedo2, "albedo2", 0.2)?;
+                let scale = self.positive(span, &what("scale"), m.scale.unwrap_or(1.0))?;
+                Material::checker(a, a2, scale)
+            }
+            MaterialType::Phong => {
+                let specular = albedo(m.specular, "specular", 0.04)?;
+                let exponent =
+                    self.non_negative(span, &what("exponent"), m.exponent.unwrap_or(32.0))?;
+                Material::phong(a, specular, exponent)
+            }
+        })
+    }
+
+    fn object(
+        &self,
+        index: usize,
+        desc: &Spanned<ObjectDesc>,
+        scene: &SceneDesc,
+    ) -> Result<(Shape, String)> {
+        let span = desc.span();
+        let o = desc.get_ref();
+        let kind = format!("{:?}", o.kind).to_lowercase();
+        let label = format!("objects[{index}] ({kind})");
+        let fields: [(&str, bool); 10] = [
+            ("center", o.center.is_some()),
+            ("radius", o.radius.is_some()),
+            ("point", o.point.is_some()),
+            ("normal", o.normal.is_some()),
+            ("corner", o.corner.is_some()),
+            ("edge_u", o.edge_u.is_some()),
+            ("edge_v", o.edge_v.is_some()),
+            ("min", o.min.is_some()),
+            ("max", o.max.is_some()),
+            ("file", o.file.is_some()),
+        ];
+        let takes: &[&str] = match o.kind {
+            ObjectType::Sphere => &["center", "radius"],
+            ObjectType::Plane => &["point", "normal"],
+            ObjectType::Quad => &["corner", "edge_u", "edge_v"],
+            ObjectType::Box => &["min", "max"],
+            ObjectType::Mesh => &["file"],
+        };
+        self.check_fields(span.clone(), &label, &kind, &fields, takes)?;
+        let get = |p: Option<Point>, name: &str| {
+            self.finite3(span.clone(), &format!("{label}.{name}"), p.unwrap().0)
+        };
+        let shape = match o.kind {
+            ObjectType::Sphere => {
+                let radius =
+                    self.positive(span.clone(), &format!("{label}.radius"), o.radius.unwrap())?;
+                Shape::sphere(get(o.center, "center")?, radius)
+            }
+            ObjectType::Plane => {
+                let normal = self.nonzero3(
+                    span.clone(),
+                    &format!("{label}.normal"),
+                    o.normal.unwrap().0,
+                )?;
+                Shape::plane(get(o.point, "point")?, normal)
+            }
+            ObjectType::Quad => {
+                let (u, v) = (get(o.edge_u, "edge_u")?, get(o.edge_v, "edge_v")?);
+                if u.cross(v).length_squared() == 0.0 {
+                    return Err(self.err(
+                        span,
+                        format!("{label}: edge_u and edge_v must not be parallel or zero"),
+                    ));
+                }
+                Shape::quad(get(o.corner, "corner")?, u, v)
+            }
+            ObjectType::Box => {
+                let (min, max) = (get(o.min, "min")?, get(o.max, "max")?);
+                if !min.cmplt(max).all() {
+                    return Err(self.err(span, format!("{label}: min must be less than max on every axis, got min {min} max {max}")));
+                }
+                Shape::cuboid(min, max)
+            }
+            ObjectType::Mesh => self.mesh(&label, o.file.as_ref().unwrap())?,
+        };
+        let transform = self.transform(span.clone(), &label, o)?;
+        let material = match &o.material {
+            Some(name) => {
+                if !scene.materials.contains_key(name.get_ref()) {
+                    let known: Vec<&str> = scene.materials.keys().map(String::as_str).collect();
+                    return Err(self.err(
+                        name.span(),
+                        format!(
+                            "{label}: unknown material `{}`; the scene defines: {}",
+                            name.get_ref(),
+                            list(&known)
+                        ),
+                    ));
+                }
+                name.get_ref().clone()
+            }
+            None => {
+                return Err(self.err(
+                    span,
+                    format!("{label} needs a `material` (a name from [materials])"),
+                ));
+            }
+        };
+        Ok((shape.transformed(transform), material))
+    }
+
+    /// Checks that an object or light has every field its type needs and
+    /// none that belongs to another type.
+    fn check_fields(
+        &self,
+        span: Range<usize>,
+        label: &str,
+        kind: &str,
+        fields: &[(&str, bool)],
+        takes: &[&str],
+    ) -> Result<()> {
+        for (name, present) in fields {
+            if *present && !takes.contains(name) {
+                return Err(self.err(
+                    span,
+                    format!(
+                        "{label}: `{name}` does not belong to a {kind}, which takes {}",
+                        list(takes)
+                    ),
+                ));
+            }
+        }
+        for name in takes {
+            if !fields.iter().any(|(n, present)| n == name && *present) {
+                return Err(self.err(span, format!("{label}: a {kind} needs `{name}`")));
+            }
+        }
+        Ok(())
+    }
+
+    /// T·Rz·Ry·Rx·S: scale, then rotate about X, Y, Z (degrees), then translate.
+    fn transform(&self, span: Range<usize>, label: &str, o: &ObjectDesc) -> Result<Affine3A> {
+        let translate = self.finite3(
+            span.clone(),
+            &format!("{label}.translate"),
+            o.translate.map_or(Vec3::ZERO, |p| p.0),
+        )?;
+        let rotate = self.finite3(
+            span.clone(),
+            &format!("{label}.rotate"),
+            o.rotate.map_or(Vec3::ZERO, |p| p.0),
+        )?;
+        let scale = self.finite3(
+            span.clone(),
+            &format!("{label}.scale"),
+            o.scale.map_or(Vec3::ONE, |p| p.0),
+        )?;
+        if scale.cmpeq(Vec3::ZERO).any() {
+            return Err(self.err(
+                span,
+                format!("{label}.scale must not be zero on any axis, got {scale}"),
+            ));
+        }
+        let r = rotate * (std::f32::consts::PI / 180.0);
+        let rotation =
+            Quat::from_rotation_z(r.z) * Quat::from_rotation_y(r.y) * Quat::from_rotation_x(r.x);
+        Ok(Affine3A::from_scale_rotation_translation(
+            scale, rotation, translate,
+        ))
+    }
+
+    fn mesh(&self, label: &str, file: &Spanned<String>) -> Result<Shape> {
+        let path = match self.base_dir {
+            Some(dir) => dir.join(file.get_ref()),
+            None => file.get_ref().into(),
+        };
+        let fail = |why: String| {
+            self.err(
+                file.span(),
+                format!("{label}: cannot load mesh `{}`: {why}", path.display()),
+            )
+        };
+        let options = tobj::LoadOptions {
+            triangulate: true,
+            single_index: true,
+            ..Default::default()
+        };
+        let (models, _) = tobj::load_obj(&path, &options).map_err(|e| fail(e.to_string()))?;
+        let mut positions = Vec::new();
+        let mut triangles = Vec::new();
+        for model in &models {
+            let m = &model.mesh;
+            let base = positions.len() as u32;
+            for p in m.positions.chunks_exact(3) {
+                let v = Vec3::new(p[0], p[1], p[2]);
+                if !v.is_finite() {
+                    return Err(fail(format!("vertex {} is not finite", positions.len())));
+                }
+                positions.push(v);
+            }
+            let count = m.positions.len() / 3;
+            for t in m.indices.chunks_exact(3) {
+                if t.iter().any(|&i| i as usize >= count) {
+                    return Err(fail(format!(
+                        "a face refers to vertex {} of {count}",
+                        t.iter().max().unwrap() + 1
+                    )));
+                }
+                triangles.push([base + t[0], base + t[1], base + t[2]]);
+            }
+        }
+        if triangles.is_empty() {
+            return Err(fail("it holds no faces".into()));
+        }
+        Ok(Shape::Mesh {
+            positions,
+            triangles,
+        })
+    }
+
+    fn light(&self, index: usize, desc: &Spanned<LightDesc>) -> Result<Light> {
+        let span = desc.span();
+        let l = desc.get_ref();
+        let kind = format!("{:?}", l.kind).to_lowercase();
+        let label = format!("lights[{index}] ({kind})");
+        let fields: [(&str, bool); 14] = [
+            ("position", l.position.is_some()),
+            ("intensity", l.intensity.is_some()),
+            ("direction", l.direction.is_some()),
+            ("look_at", l.look_at.is_some()),
+            ("cone_angle", l.cone_angle.is_some()),
+            ("falloff_start", l.falloff_start.is_some()),
+            ("profile", l.profile.is_some()),
+            ("irradiance", l.irradiance.is_some()),
+            ("center", l.center.is_some()),
+            ("radius", l.radius.is_some()),
+            ("radiance", l.radiance.is_some()),
+            ("corner", l.corner.is_some()),
+            ("edge_u", l.edge_u.is_some()),
+            ("edge_v", l.edge_v.is_some()),
+        ];
+        let at = |name: &str| format!("{label}.{name}");
+        let point =
+            |p: Option<Point>, name: &str| self.finite3(span.clone(), &at(name), p.unwrap().0);
+        let power = |t: Option<Triple>, name: &str| {
+            self.non_negative3(span.clone(), &at(name), t.unwrap().0)
+        };
+        match l.kind {
+            LightType::Point => {
+                self.check_fields(
+                    span.clone(),
+                    &label,
+                    &kind,
+                    &fields,
+                    &["position", "intensity"],
+                )?;
+                Ok(Light::point(
+                    point(l.position, "position")?,
+                    power(l.intensity, "intensity")?,
+                ))
+            }
+            LightType::Spot => {
+                // A spot takes a direction or a look_at, and optional angles.
+                let optional = [
+                    "cone_angle",
+                    "falloff_start",
+                    "profile",
+                    "direction",
+                    "look_at",
+                ];
+                let given: Vec<(&str, bool)> = fields
+                    .iter()
+                    .copied()
+                    .filter(|(n, _)| !optional.contains(n))
+                    .collect();
+                self.check_fields(
+                    span.clone(),
+                    &label,
+                    &kind,
+                    &given,
+                    &["position", "intensity"],
+                )?;
+                let position = point(l.position, "position")?;
+                let direction = match (l.direction, l.look_at) {
+                    (Some(d), None) => self.nonzero3(span.clone(), &at("direction"), d.0)?,
+                    (None, Some(t)) => self
+                        .nonzero3(span.clone(), &at("look_at"), t.0 - position)
+                        .map_err(|_| {
+                            self.err(
+                                span.clone(),
+                                format!("{label}: look_at must differ from position"),
+                            )
+                        })?,
+                    (Some(_), Some(_)) => {
+                        return Err(self.err(
+                            span,
+                            format!("{label}: give direction or look_at, not both"),
+                        ));
+                    }
+                    (None, None) => {
+                        return Err(self.err(
+                            span,
+                            format!("{label}: a spot needs `direction` or `look_at`"),
+                        ));
+                    }
+                };
+                let cone = l.cone_angle.unwrap_or(30.0);
+                if !(cone > 0.0 && cone <= 180.0) {
+                    return Err(self.err(
+                        span,
+                        format!("{label}.cone_angle must be in (0, 180] degrees, got {cone}"),
+                    ));
+                }
+                let start = l.falloff_start.unwrap_or(cone);
+                if !(start >= 0.0 && start <= cone) {
+                    return Err(self.err(span, format!("{label}.falloff_start must be in [0, cone_angle = {cone}] degrees, got {start}")));
+                }
+                Ok(Light::Spot {
+                    position,
+                    direction: direction.normalize(),
+                    intensity: power(l.intensity, "intensity")?,
+                    cone_angle: cone.to_radians(),
+                    falloff_start: start.to_radians(),
+                    profile: l.profile.map_or(SpotProfile::Smoothstep, Into::into),
+                })
+            }
+            LightType::Distant => {
+                self.check_fields(
+                    span.clone(),
+                    &label,
+                    &kind,
+                    &fields,
+                    &["direction", "irradiance"],
+                )?;
+                let d = self.nonzero3(span.clone(), &at("direction"), l.direction.unwrap().0)?;
+                Ok(Light::distant(d, power(l.irradiance, "irradiance")?))
+            }
+            LightType::Sphere => {
+                self.check_fields(
+                    span.clone(),
+                    &label,
+                    &kind,
+                    &fields,
+                    &["center", "radius", "radiance"],
+                )?;
+                let radius = self.positive(span.clone(), &at("radius"), l.radius.unwrap())?;
+                Ok(Light::sphere(
+                    point(l.center, "center")?,
+                    radius,
+                    power(l.radiance, "radiance")?,
+                ))
+            }
+            LightType::Quad => {
+                self.check_fields(
+                    span.clone(),
+                    &label,
+                    &kind,
+                    &fields,
+                    &["corner", "edge_u", "edge_v", "radiance"],
+                )?;
+                let (u, v) = (point(l.edge_u, "edge_u")?, point(l.edge_v, "edge_v")?);
+                if u.cross(v).length_squared() == 0.0 {
+                    return Err(self.err(
+                        span,
+                        format!("{label}: edge_u and edge_v must not be parallel or zero"),
+                    ));
+                }
+                Ok(Light::quad(
+                    point(l.corner, "corner")?,
+                    u,
+                    v,
+                    power(l.radiance, "radiance")?,
+                ))
+            }
+        }
+    }
+}
+
+fn list(names: &[&str]) -> String {
+    if names.is_empty() {
+        return "(none)".into();
+    }
+    names
+        .iter()
+        .map(|n| format!("`{n}`"))
+        .collect::<Vec<_>>()
+        .join(", ")
+}

@@ -1,0 +1,273 @@
+//! The scene file as written: plain serde structs for DESIGN.md's "Scene file
+//! schema (version 1)". Unknown keys are errors. `build.rs` checks the values
+//! and turns them into a [`Scene`](super::Scene).
+
+use crate::integrator::IntegratorKind;
+use crate::light::SpotProfile;
+use crate::scene::Tonemap;
+use glam::Vec3;
+use serde::Deserialize;
+use serde::de::{self, Deserializer, SeqAccess, Visitor};
+use std::collections::BTreeMap;
+use std::fmt;
+use toml::Spanned;
+
+/// A whole scene file.
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneDesc {
+    #[serde(default)]
+    pub render: RenderDesc,
+    pub camera: Option<Spanned<CameraDesc>>,
+    pub medium: Option<Spanned<MediumDesc>>,
+    #[serde(default)]
+    pub materials: BTreeMap<String, Spanned<MaterialDesc>>,
+    #[serde(default)]
+    pub objects: Vec<Spanned<ObjectDesc>>,
+    #[serde(default)]
+    pub lights: Vec<Spanned<LightDesc>>,
+}
+
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RenderDesc {
+    pub width: Option<Spanned<i64>>,
+    pub height: Option<Spanned<i64>>,
+    pub integrator: Option<IntegratorKind>,
+    pub spp: Option<Spanned<i64>>,
+    pub steps: Option<Spanned<i64>>,
+    pub max_distance: Option<Spanned<f32>>,
+    pub max_depth: Option<Spanned<i64>>,
+    pub seed: Option<Spanned<i64>>,
+    pub background: Option<Spanned<Triple>>,
+    pub exposure: Option<Spanned<f32>>,
+    pub tonemap: Option<Tonemap>,
+    pub jitter: Option<bool>,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum CameraType {
+    Perspective,
+    Orthographic,
+    Isometric,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CameraDesc {
+    #[serde(rename = "type", default = "perspective")]
+    pub kind: CameraType,
+    pub position: Option<Point>,
+    pub look_at: Option<Point>,
+    pub up: Option<Point>,
+    pub fov: Option<f32>,
+    pub view_height: Option<f32>,
+    pub aperture: Option<f32>,
+    pub focus_distance: Option<f32>,
+    /// Isometric only: how far back from look_at the camera stands.
+    pub distance: Option<f32>,
+}
+
+fn perspective() -> CameraType {
+    CameraType::Perspective
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum MediumType {
+    Homogeneous,
+    Height,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MediumDesc {
+    #[serde(rename = "type", default = "homogeneous")]
+    pub kind: MediumType,
+    pub sigma_a: Option<Triple>,
+    pub sigma_s: Option<Triple>,
+    pub g: Option<f32>,
+    pub base: Option<f32>,
+    pub falloff: Option<f32>,
+}
+
+fn homogeneous() -> MediumType {
+    MediumType::Homogeneous
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum MaterialType {
+    Diffuse,
+    Checker,
+    Phong,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MaterialDesc {
+    #[serde(rename = "type", default = "diffuse")]
+    pub kind: MaterialType,
+    pub albedo: Option<Triple>,
+    pub albedo2: Option<Triple>,
+    pub scale: Option<f32>,
+    pub specular: Option<Triple>,
+    pub exponent: Option<f32>,
+}
+
+fn diffuse() -> MaterialType {
+    MaterialType::Diffuse
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ObjectType {
+    Sphere,
+    Plane,
+    Quad,
+    Box,
+    Mesh,
+}
+
+/// One `[[objects]]` table. Fields are optional here; which ones a type
+/// needs (and allows) is checked when the scene is built.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ObjectDesc {
+    #[serde(rename = "type")]
+    pub kind: ObjectType,
+    pub material: Option<Spanned<String>>,
+    pub center: Option<Point>,
+    pub radius: Option<f32>,
+    pub point: Option<Point>,
+    pub normal: Option<Point>,
+    pub corner: Option<Point>,
+    pub edge_u: Option<Point>,
+    pub edge_v: Option<Point>,
+    pub min: Option<Point>,
+    pub max: Option<Point>,
+    pub file: Option<Spanned<String>>,
+    pub translate: Option<Point>,
+    pub rotate: Option<Point>,
+    pub scale: Option<Triple>,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum LightType {
+    Point,
+    Spot,
+    Distant,
+    Sphere,
+    Quad,
+}
+
+/// One `[[lights]]` table; as for objects, the fields a type needs are
+/// checked when the scene is built.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LightDesc {
+    #[serde(rename = "type")]
+    pub kind: LightType,
+    pub position: Option<Point>,
+    pub intensity: Option<Triple>,
+    pub direction: Option<Point>,
+    pub look_at: Option<Point>,
+    pub cone_angle: Option<f32>,
+    pub falloff_start: Option<f32>,
+    pub profile: Option<SpotProfileDesc>,
+    pub irradiance: Option<Triple>,
+    pub center: Option<Point>,
+    pub radius: Option<f32>,
+    pub radiance: Option<Triple>,
+    pub corner: Option<Point>,
+    pub edge_u: Option<Point>,
+    pub edge_v: Option<Point>,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum SpotProfileDesc {
+    Smoothstep,
+    Linear,
+}
+
+impl From<SpotProfileDesc> for SpotProfile {
+    fn from(p: SpotProfileDesc) -> Self {
+        match p {
+            SpotProfileDesc::Smoothstep => SpotProfile::Smoothstep,
+            SpotProfileDesc::Linear => SpotProfile::Linear,
+        }
+    }
+}
+
+/// A point or vector: exactly three numbers (integers allowed).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Point(pub Vec3);
+
+/// A colour, coefficient or scale: one number (the same on all three
+/// channels or axes) or three.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Triple(pub Vec3);
+
+struct TripleVisitor {
+    allow_scalar: bool,
+}
+
+impl<'de> Visitor<'de> for TripleVisitor {
+    type Value = Vec3;
+
+    fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+        if self.allow_scalar {
+            f.write_str("a number or an array of three numbers")
+        } else {
+            f.write_str("an array of three numbers")
+        }
+    }
+
+    fn visit_f64<E: de::Error>(self, v: f64) -> Result<Vec3, E> {
+        if self.allow_scalar {
+            Ok(Vec3::splat(v as f32))
+        } else {
+            Err(E::invalid_type(de::Unexpected::Float(v), &self))
+        }
+    }
+
+    fn visit_i64<E: de::Error>(self, v: i64) -> Result<Vec3, E> {
+        if self.allow_scalar {
+            Ok(Vec3::splat(v as f32))
+        } else {
+            Err(E::invalid_type(de::Unexpected::Signed(v), &self))
+        }
+    }
+
+    fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<Vec3, A::Error> {
+        let mut v = [0.0f32; 3];
+        for (i, slot) in v.iter_mut().enumerate() {
+            *slot = seq
+                .next_element::<f32>()?
+                .ok_or_else(|| de::Error::invalid_length(i, &self))?;
+        }
+        if seq.next_element::<de::IgnoredAny>()?.is_some() {
+            return Err(de::Error::invalid_length(4, &self));
+        }
+        Ok(Vec3::from_array(v))
+    }
+}
+
+impl<'de> Deserialize<'de> for Point {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        d.deserialize_any(TripleVisitor {
+            allow_scalar: false,
+        })
+        .map(Point)
+    }
+}
+
+impl<'de> Deserialize<'de> for Triple {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        d.deserialize_any(TripleVisitor { allow_scalar: true })
+            .map(Triple)
+    }
+}

@@ -1,0 +1,289 @@
+//! The render-time [`Scene`], the [`SceneBuilder`] that makes one in Rust, and
+//! the TOML scene description ([`SceneDesc`]) that makes one from a file.
+
+mod build;
+mod desc;
+mod error;
+
+pub use build::{from_toml_str, load};
+pub use desc::SceneDesc;
+pub use error::{SceneError, line_col};
+
+use crate::Rgb;
+use crate::camera::Camera;
+use crate::geometry::{Geometry, GeometryBuilder, Shape};
+use crate::integrator::IntegratorKind;
+use crate::light::Light;
+use crate::material::Material;
+use crate::medium::Medium;
+use glam::{Affine3A, Vec3};
+use std::collections::HashMap;
+
+/// How the image is turned into 8-bit PNG values (EXR output is always linear).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Tonemap {
+    /// Clip to [0, 1].
+    #[default]
+    Clamp,
+    /// The ACES filmic curve as fitted by Narkowicz (2015).
+    Filmic,
+}
+
+/// The `[render]` settings.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RenderSettings {
+    pub width: u32,
+    pub height: u32,
+    pub integrator: IntegratorKind,
+    /// Samples per pixel.
+    pub spp: u32,
+    /// March samples per ray (raymarch).
+    pub steps: u32,
+    /// How far a ray that hits nothing is followed (and marched).
+    pub max_distance: f32,
+    /// Most scattering events (path).
+    pub max_depth: u32,
+    pub seed: u64,
+    /// Radiance of rays that escape.
+    pub background: Rgb,
+    /// Stops, for PNG output only.
+    pub exposure: f32,
+    pub tonemap: Tonemap,
+    /// Offset march samples by a random fraction of a step per pixel sample.
+    pub jitter: bool,
+}
+
+impl Default for RenderSettings {
+    fn default() -> Self {
+        RenderSettings {
+            width: 640,
+            height: 480,
+            integrator: IntegratorKind::Direct,
+            spp: 16,
+            steps: 64,
+            max_distance: 100.0,
+            max_depth: 8,
+            seed: 0,
+            background: Rgb::ZERO,
+            exposure: 0.0,
+            tonemap: Tonemap::Clamp,
+            jitter: true,
+        }
+    }
+}
+
+/// Everything a render needs, built and validated.
+#[derive(Debug)]
+pub struct Scene {
+    pub settings: RenderSettings,
+    pub camera: Camera,
+    pub materials: Vec<Material>,
+    pub lights: Vec<Light>,
+    pub medium: Option<Medium>,
+    pub geometry: Geometry,
+    /// Centre and radius of a sphere around the bounded geometry, the lights
+    /// and the camera; a sun's light enters the scene from its surface, as in
+    /// pbrt-v4 and Mitsuba 3.
+    pub bounds_center: Vec3,
+    pub bounds_radius: f32,
+}
+
+impl Scene {
+    /// The distance a shadow ray toward a light sample should span: the
+    /// sample's distance, or for a sun, across the scene's bounding sphere.
+    pub fn light_distance(&self, distance: f32) -> f32 {
+        if distance.is_finite() {
+            distance
+        } else {
+            2.0 * self.bounds_radius
+        }
+    }
+}
+
+/// Builds a [`Scene`] in Rust, as the seed's World/Camera example does.
+#[derive(Default)]
+pub struct SceneBuilder {
+    settings: RenderSettings,
+    camera: Option<Camera>,
+    materials: Vec<Material>,
+    material_names: HashMap<String, u32>,
+    objects: Vec<(Shape, String)>,
+    lights: Vec<Light>,
+    medium: Option<Medium>,
+}
+
+impl SceneBuilder {
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    pub fn size(mut self, width: u32, height: u32) -> Self {
+        self.settings.width = width;
+        self.settings.height = height;
+        self
+    }
+
+    pub fn settings(mut self, settings: RenderSettings) -> Self {
+        self.settings = settings;
+        self
+    }
+
+    /// Changes the settings in place.
+    pub fn with_settings(mut self, change: impl FnOnce(&mut RenderSettings)) -> Self {
+        change(&mut self.settings);
+        self
+    }
+
+    pub fn camera(mut self, camera: Camera) -> Self {
+        self.camera = Some(camera);
+        self
+    }
+
+    /// Names a material; a later one of the same name replaces it.
+    pub fn material(mut self, name: &str, material: Material) -> Self {
+        match self.material_names.get(name) {
+            Some(&i) => self.materials[i as usize] = material,
+            None => {
+                self.material_names
+                    .insert(name.to_string(), self.materials.len() as u32);
+                self.materials.push(material);
+            }
+        }
+        self
+    }
+
+    pub fn object(mut self, shape: Shape, material: &str) -> Self {
+        self.objects.push((shape, material.to_string()));
+        self
+    }
+
+    pub fn object_transformed(self, shape: Shape, transform: Affine3A, material: &str) -> Self {
+        self.object(shape.transformed(transform), material)
+    }
+
+    pub fn light(mut self, light: Light) -> Self {
+        self.lights.push(light);
+        self
+    }
+
+    pub fn medium(mut self, medium: Medium) -> Self {
+        self.medium = Some(medium);
+        self
+    }
+
+    /// Checks and builds the scene, with its BVH.
+    pub fn build(self) -> Result<Scene, SceneError> {
+        let SceneBuilder {
+            settings,
+            camera,
+            mut materials,
+            material_names,
+            objects,
+            lights,
+            medium,
+        } = self;
+        if settings.width == 0 || settings.height == 0 {
+            return Err(SceneError::new(format!(
+                "image size must be at least 1×1, got {}×{}",
+                settings.width, settings.height
+            )));
+        }
+        if settings.spp == 0 {
+            return Err(SceneError::new("spp must be at least 1"));
+        }
+        if settings.steps == 0 {
+            return Err(SceneError::new("steps must be at least 1"));
+        }
+        let camera = camera.unwrap_or_else(default_camera);
+        let mut geometry = GeometryBuilder::default();
+        for (shape, name) in &objects {
+            let Some(&material) = material_names.get(name) else {
+                return Err(SceneError::new(format!("unknown material `{name}`")));
+            };
+            geometry.add(shape, material, None);
+        }
+        // Area lights are surfaces too: the camera sees them, and they cast
+        // shadows. They reflect nothing.
+        let black = materials.len() as u32;
+        materials.push(Material::BLACK);
+        for (i, light) in lights.iter().enumerate() {
+            let shape = match *light {
+                Light::Sphere { center, radius, .. } => Shape::sphere(center, radius),
+                Light::Quad {
+                    corner,
+                    edge_u,
+                    edge_v,
+                    ..
+                } => Shape::quad(corner, edge_u, edge_v),
+                _ => continue,
+            };
+            geometry.add(&shape, black, Some(i as u32));
+        }
+        let geometry = geometry.build();
+        let (bounds_center, bounds_radius) = bounding_sphere(&geometry, &lights, &camera);
+        Ok(Scene {
+            settings,
+            camera,
+            materials,
+            lights,
+            medium,
+            geometry,
+            bounds_center,
+            bounds_radius,
+        })
+    }
+}
+
+/// The camera of a scene that names none: DESIGN.md's example camera.
+pub fn default_camera() -> Camera {
+    Camera::look_at(
+        Vec3::new(0.0, 2.0, -6.0),
+        Vec3::new(0.0, 1.0, 0.0),
+        Vec3::Y,
+        40.0,
+    )
+}
+
+fn bounding_sphere(geometry: &Geometry, lights: &[Light], camera: &Camera) -> (Vec3, f32) {
+    let mut min = camera.position;
+    let mut max = camera.position;
+    let mut grow = |p: Vec3| {
+        min = min.min(p);
+        max = max.max(p);
+    };
+    if let Some((lo, hi)) = geometry.bounds() {
+        grow(lo);
+        grow(hi);
+    }
+    for light in lights {
+        match *light {
+            Light::Point { position, .. } | Light::Spot { position, .. } => grow(position),
+            Light::Sphere { center, radius, .. } => {
+                grow(center - radius);
+                grow(center + radius);
+            }
+            Light::Quad {
+                corner,
+                edge_u,
+                edge_v,
+                ..
+            } => {
+                for p in [
+                    corner,
+                    corner + edge_u,
+                    corner + edge_v,
+                    corner + edge_u + edge_v,
+                ] {
+                    grow(p);
+                }
+            }
+            Light::Distant { .. } => {}
+        }
+    }
+    let center = 0.5 * (min + max);
+    (center, (0.5 * (max - min).length()).max(1.0))
+}
+
+#[cfg(test)]
+mod tests;
