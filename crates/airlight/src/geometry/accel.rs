@@ -120,7 +120,11 @@ impl Prim {
 
 impl Boundable for Record {
     fn aabb(&self) -> Aabb {
-        self.prim.bounds()
+        // Pad every box: a quad or triangle lying in an axis plane has a flat
+        // box, which a ray along that plane's normal would pass as empty.
+        let b = self.prim.bounds();
+        let pad = 1e-5 * (1.0 + b.min.abs().max(b.max.abs()).max_element());
+        Aabb::new(b.min - pad, b.max + pad)
     }
 }
 
@@ -306,7 +310,7 @@ impl Geometry {
             id: u32::MAX,
         };
         if let Some(bvh) = &self.bvh {
-            let r = obvhs::ray::Ray::new(ray.origin.into(), ray.dir.into(), 0.0, tmax);
+            let r = bvh_ray(ray.origin, ray.dir, tmax);
             let mut hit = obvhs::ray::RayHit::none();
             if bvh.ray_traverse(r, &mut hit, |r, id| {
                 self.records[id]
@@ -342,7 +346,7 @@ impl Geometry {
         }
         match &self.bvh {
             Some(bvh) => {
-                let r = obvhs::ray::Ray::new(origin.into(), dir.into(), 0.0, tmax);
+                let r = bvh_ray(origin, dir, tmax);
                 !bvh.ray_traverse_miss(r, |r, id| {
                     self.records[id].prim.intersect(origin, dir, 0.0, r.tmax)
                 })
@@ -399,6 +403,14 @@ impl Geometry {
             }
         }
     }
+}
+
+/// The traversal's ray. Adding +0 turns −0 components into +0: obvhs takes
+/// the ray's octant from `d < 0` but its inverse direction from the sign bit,
+/// and a −0 (as in −Vec3::Y) makes the two disagree and the ray miss.
+#[inline]
+fn bvh_ray(origin: Vec3, dir: Vec3, tmax: f32) -> obvhs::ray::Ray {
+    obvhs::ray::Ray::new(origin.into(), Vec3A::from(dir) + Vec3A::ZERO, 0.0, tmax)
 }
 
 #[inline]

@@ -34,7 +34,7 @@ fn estimated_irradiance(light: &Light, p: Vec3, n: Vec3, k: usize) -> f64 {
 fn quad_light_irradiance_matches_lambert_closed_form() {
     // A 2×1 light, 1.5 above a point and offset, facing down.
     let corner = Vec3::new(-0.3, 1.5, -0.4);
-    let (eu, ev) = (Vec3::new(0.0, 0.0, 1.0), Vec3::new(2.0, 0.0, 0.0));
+    let (eu, ev) = (Vec3::new(2.0, 0.0, 0.0), Vec3::new(0.0, 0.0, 1.0));
     assert!(eu.cross(ev).y < 0.0, "faces down");
     let light = Light::quad(corner, eu, ev, Rgb::splat(3.0));
     let verts: Vec<glam::DVec3> = [corner, corner + eu, corner + eu + ev, corner + ev]

@@ -47,6 +47,35 @@ impl Checker<'_> {
         SceneError::at(self.text, span.start, message)
     }
 
+    /// An error about `what` (a dotted path such as `objects[2] (sphere).radius`)
+    /// in the table at `span`: placed at the field's value when the table
+    /// spells the field out, else at the table.
+    fn err_field(&self, span: Range<usize>, what: &str, message: impl Into<String>) -> SceneError {
+        let field = what.rsplit('.').next().unwrap_or(what);
+        SceneError::at(self.text, self.locate(span.start, field), message)
+    }
+
+    /// The offset of `field`'s value in the table starting at `start`, or
+    /// `start` when the field is not written there.
+    fn locate(&self, start: usize, field: &str) -> usize {
+        let mut offset = start;
+        for (i, line) in self.text[start..].split_inclusive('\n').enumerate() {
+            let trimmed = line.trim_start();
+            if i > 0 && trimmed.starts_with('[') {
+                break;
+            }
+            if let Some(rest) = trimmed.strip_prefix(field) {
+                let rest_trimmed = rest.trim_start();
+                if let Some(value) = rest_trimmed.strip_prefix('=') {
+                    let value_start = line.len() - value.trim_start().len();
+                    return offset + value_start;
+                }
+            }
+            offset += line.len();
+        }
+        start
+    }
+
     fn scene(&self, desc: SceneDesc) -> Result<Scene> {
         let settings = self.settings(&desc)?;
         let mut builder = SceneBuilder::new().settings(settings);
@@ -124,7 +153,11 @@ impl Checker<'_> {
         if v.is_finite() {
             Ok(v)
         } else {
-            Err(self.err(span, format!("{what} must be a finite number, got {v}")))
+            Err(self.err_field(
+                span,
+                what,
+                format!("{what} must be a finite number, got {v}"),
+            ))
         }
     }
 
@@ -132,8 +165,9 @@ impl Checker<'_> {
         if v.is_finite() && v > 0.0 {
             Ok(v)
         } else {
-            Err(self.err(
+            Err(self.err_field(
                 span,
+                what,
                 format!("{what} must be a positive finite number, got {v}"),
             ))
         }
@@ -143,7 +177,11 @@ impl Checker<'_> {
         if v.is_finite() && v >= 0.0 {
             Ok(v)
         } else {
-            Err(self.err(span, format!("{what} must be a finite number ≥ 0, got {v}")))
+            Err(self.err_field(
+                span,
+                what,
+                format!("{what} must be a finite number ≥ 0, got {v}"),
+            ))
         }
     }
 
@@ -151,7 +189,7 @@ impl Checker<'_> {
         if v.is_finite() {
             Ok(v)
         } else {
-            Err(self.err(span, format!("{what} must be finite, got {v}")))
+            Err(self.err_field(span, what, format!("{what} must be finite, got {v}")))
         }
     }
 
@@ -159,7 +197,11 @@ impl Checker<'_> {
         if v.is_finite() && v.min_element() >= 0.0 {
             Ok(v)
         } else {
-            Err(self.err(span, format!("{what} must be finite and ≥ 0, got {v}")))
+            Err(self.err_field(
+                span,
+                what,
+                format!("{what} must be finite and ≥ 0, got {v}"),
+            ))
         }
     }
 
@@ -168,7 +210,7 @@ impl Checker<'_> {
         if v.length_squared() > 0.0 {
             Ok(v)
         } else {
-            Err(self.err(span, format!("{what} must not be zero")))
+            Err(self.err_field(span, what, format!("{what} must not be zero")))
         }
     }
 
@@ -201,43 +243,49 @@ impl Checker<'_> {
         };
         let forward = look_at - position;
         if forward.length_squared() == 0.0 {
-            return Err(self.err(span, "camera.position and camera.look_at must differ"));
+            return Err(self.err_field(
+                span,
+                "look_at",
+                "camera.position and camera.look_at must differ",
+            ));
         }
         if forward.normalize().cross(up.normalize()).length() < 1e-6 {
             return Err(self.err(span, "camera.up must not be parallel to the view direction"));
         }
-        let projection = match c.kind {
-            CameraType::Perspective => {
-                if c.view_height.is_some() {
-                    return Err(self.err(
-                        span,
+        let projection =
+            match c.kind {
+                CameraType::Perspective => {
+                    if c.view_height.is_some() {
+                        return Err(self.err_field(
+                        span, "view_height",
                         "view_height is for orthographic cameras; a perspective camera takes fov",
                     ));
+                    }
+                    let fov = c.fov.unwrap_or(40.0);
+                    if !(fov > 0.0 && fov < 180.0) {
+                        return Err(self.err_field(
+                            span,
+                            "fov",
+                            format!("camera.fov must be between 0 and 180 degrees, got {fov}"),
+                        ));
+                    }
+                    Projection::Perspective { fov_degrees: fov }
                 }
-                let fov = c.fov.unwrap_or(40.0);
-                if !(fov > 0.0 && fov < 180.0) {
-                    return Err(self.err(
-                        span,
-                        format!("camera.fov must be between 0 and 180 degrees, got {fov}"),
-                    ));
-                }
-                Projection::Perspective { fov_degrees: fov }
-            }
-            CameraType::Orthographic | CameraType::Isometric => {
-                if c.fov.is_some() {
-                    return Err(self.err(
-                        span,
+                CameraType::Orthographic | CameraType::Isometric => {
+                    if c.fov.is_some() {
+                        return Err(self.err_field(
+                        span, "fov",
                         "fov is for perspective cameras; an orthographic camera takes view_height",
                     ));
+                    }
+                    let h = self.positive(
+                        span.clone(),
+                        "camera.view_height",
+                        c.view_height.unwrap_or(10.0),
+                    )?;
+                    Projection::Orthographic { view_height: h }
                 }
-                let h = self.positive(
-                    span.clone(),
-                    "camera.view_height",
-                    c.view_height.unwrap_or(10.0),
-                )?;
-                Projection::Orthographic { view_height: h }
-            }
-        };
+            };
         let aperture =
             self.non_negative(span.clone(), "camera.aperture", c.aperture.unwrap_or(0.0))?;
         let focus = c.focus_distance.unwrap_or(forward.length());
@@ -260,16 +308,18 @@ impl Checker<'_> {
         )?;
         let g = m.g.unwrap_or(0.0);
         if !(g > -1.0 && g < 1.0) {
-            return Err(self.err(
+            return Err(self.err_field(
                 span,
+                "g",
                 format!("medium.g must lie strictly between -1 and 1, got {g}"),
             ));
         }
         match m.kind {
             MediumType::Homogeneous => {
                 if m.base.is_some() || m.falloff.is_some() {
-                    return Err(self.err(
+                    return Err(self.err_field(
                         span,
+                        if m.base.is_some() { "base" } else { "falloff" },
                         "base and falloff belong to a `height` medium, not a homogeneous one",
                     ));
                 }
@@ -297,8 +347,9 @@ impl Checker<'_> {
         };
         let misplaced = |present: bool, field: &str, owner: &str| -> Result<()> {
             if present {
-                Err(self.err(
+                Err(self.err_field(
                     span.clone(),
+                    field,
                     format!("{} belongs to a {owner} material", what(field)),
                 ))
             } else {
@@ -380,8 +431,9 @@ impl Checker<'_> {
             ObjectType::Quad => {
                 let (u, v) = (get(o.edge_u, "edge_u")?, get(o.edge_v, "edge_v")?);
                 if u.cross(v).length_squared() == 0.0 {
-                    return Err(self.err(
+                    return Err(self.err_field(
                         span,
+                        "edge_v",
                         format!("{label}: edge_u and edge_v must not be parallel or zero"),
                     ));
                 }
@@ -390,7 +442,7 @@ impl Checker<'_> {
             ObjectType::Box => {
                 let (min, max) = (get(o.min, "min")?, get(o.max, "max")?);
                 if !min.cmplt(max).all() {
-                    return Err(self.err(span, format!("{label}: min must be less than max on every axis, got min {min} max {max}")));
+                    return Err(self.err_field(span, "max", format!("{label}: min must be less than max on every axis, got min {min} max {max}")));
                 }
                 Shape::cuboid(min, max)
             }
@@ -434,8 +486,9 @@ impl Checker<'_> {
     ) -> Result<()> {
         for (name, present) in fields {
             if *present && !takes.contains(name) {
-                return Err(self.err(
+                return Err(self.err_field(
                     span,
+                    name,
                     format!(
                         "{label}: `{name}` does not belong to a {kind}, which takes {}",
                         list(takes)
@@ -469,8 +522,9 @@ impl Checker<'_> {
             o.scale.map_or(Vec3::ONE, |p| p.0),
         )?;
         if scale.cmpeq(Vec3::ZERO).any() {
-            return Err(self.err(
+            return Err(self.err_field(
                 span,
+                "scale",
                 format!("{label}.scale must not be zero on any axis, got {scale}"),
             ));
         }
@@ -619,14 +673,15 @@ impl Checker<'_> {
                 };
                 let cone = l.cone_angle.unwrap_or(30.0);
                 if !(cone > 0.0 && cone <= 180.0) {
-                    return Err(self.err(
+                    return Err(self.err_field(
                         span,
+                        "cone_angle",
                         format!("{label}.cone_angle must be in (0, 180] degrees, got {cone}"),
                     ));
                 }
                 let start = l.falloff_start.unwrap_or(cone);
                 if !(start >= 0.0 && start <= cone) {
-                    return Err(self.err(span, format!("{label}.falloff_start must be in [0, cone_angle = {cone}] degrees, got {start}")));
+                    return Err(self.err_field(span, "falloff_start", format!("{label}.falloff_start must be in [0, cone_angle = {cone}] degrees, got {start}")));
                 }
                 Ok(Light::Spot {
                     position,
@@ -673,8 +728,9 @@ impl Checker<'_> {
                 )?;
                 let (u, v) = (point(l.edge_u, "edge_u")?, point(l.edge_v, "edge_v")?);
                 if u.cross(v).length_squared() == 0.0 {
-                    return Err(self.err(
+                    return Err(self.err_field(
                         span,
+                        "edge_v",
                         format!("{label}: edge_u and edge_v must not be parallel or zero"),
                     ));
                 }
