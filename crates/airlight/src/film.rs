@@ -67,7 +67,15 @@ impl Image {
             let p = self.pixels[pos.y() * w + pos.x()];
             (p.x, p.y, p.z)
         });
-        let image = exr::prelude::Image::from_channels((w, h), channels);
+        // Lines in increasing order: the default lets parallel compression
+        // write blocks as they finish, so the bytes would vary run to run.
+        let encoding = Encoding {
+            compression: Compression::ZIP16,
+            blocks: Blocks::ScanLines,
+            line_order: LineOrder::Increasing,
+        };
+        let layer = Layer::new((w, h), LayerAttributes::default(), encoding, channels);
+        let image = exr::prelude::Image::from_layer(layer);
         let mut out = io::Cursor::new(Vec::new());
         image
             .write()
