@@ -9,7 +9,7 @@ pub struct Direct;
 
 impl Integrator for Direct {
     fn radiance(&self, scene: &Scene, ray: &Ray, sampler: &mut Sampler) -> Rgb {
-        match scene.geometry.intersect(ray, scene.settings.max_distance) {
+        match scene.geometry.intersect(ray, f32::INFINITY) {
             Some(hit) => {
                 let surface = scene.geometry.surface(ray, hit);
                 surface_radiance(scene, ray, &surface, sampler, None)

@@ -8,6 +8,7 @@ use crate::geometry::Ray;
 use crate::medium::Medium;
 use crate::sampling::Sampler;
 use crate::scene::Scene;
+use glam::DVec3;
 
 /// The ray-marching integrator.
 ///
@@ -32,20 +33,19 @@ pub struct Raymarch {
 
 impl Integrator for Raymarch {
     fn radiance(&self, scene: &Scene, ray: &Ray, sampler: &mut Sampler) -> Rgb {
+        // A medium that neither absorbs nor scatters is vacuum.
+        let medium = scene.medium.as_ref().filter(|m| !m.is_vacuum());
         let hit = scene.geometry.intersect(ray, f32::INFINITY);
         // The surface first, so that with a vacuum the samples drawn, and so
         // the image, are exactly those of `direct`.
         let (surface, t_end) = match hit {
             Some(hit) => {
                 let s = scene.geometry.surface(ray, hit);
-                (
-                    surface_radiance(scene, ray, &s, sampler, scene.medium.as_ref()),
-                    hit.t,
-                )
+                (surface_radiance(scene, ray, &s, sampler, medium), hit.t)
             }
             None => (scene.settings.background, scene.settings.max_distance),
         };
-        let Some(medium) = &scene.medium else {
+        let Some(medium) = medium else {
             return surface;
         };
         let offset = if self.jitter { sampler.next() } else { 0.5 };
@@ -73,8 +73,10 @@ pub fn in_scattered(
     }
     let dt = t_end / steps as f32;
     let wo = -ray.dir;
-    let mut to_eye = Rgb::ONE;
-    let mut total = Rgb::ZERO;
+    // Sums in f64: over thousands of steps f32 rounding would otherwise set
+    // an error floor near 1e-5 that hides the method's own convergence.
+    let mut to_eye = DVec3::ONE;
+    let mut total = DVec3::ZERO;
     for i in 0..steps {
         let a = i as f32 * dt;
         let t = a + offset * dt;
@@ -96,10 +98,14 @@ pub fn in_scattered(
             let phase = medium.phase(wo, sample.wi);
             light_in += sample.weight * phase * medium.transmittance(p, sample.wi, 0.0, distance);
         }
-        total += to_eye * medium.sigma_s * medium.density_at(p) * weight * light_in;
-        to_eye *= Rgb::new((-tau.x).exp(), (-tau.y).exp(), (-tau.z).exp());
+        total += to_eye * (medium.sigma_s * medium.density_at(p) * weight * light_in).as_dvec3();
+        to_eye *= DVec3::new(
+            (-tau.x as f64).exp(),
+            (-tau.y as f64).exp(),
+            (-tau.z as f64).exp(),
+        );
     }
-    total
+    total.as_vec3()
 }
 
 /// ∫0^Δ e^{−τ s/Δ} ds = Δ(1 − e^{−τ})/τ per channel, → Δ as τ → 0.
