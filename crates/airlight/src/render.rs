@@ -83,12 +83,18 @@ pub fn render_with(scene: &Scene, integrator: &dyn Integrator, observer: &Render
 }
 
 /// The mean of `spp` samples of one pixel in pass `pass`.
+///
+/// Each sample draws from its own stream, keyed by (seed, pixel, sample
+/// number), so its camera ray is the same whatever the integrator draws
+/// after it: images of one scene by two integrators share their
+/// anti-aliasing and lens samples, and differ only by what the integrators
+/// compute.
 pub fn render_pixel(scene: &Scene, integrator: &dyn Integrator, x: u32, y: u32, pass: u64) -> Rgb {
     let s = &scene.settings;
     let index = y as u64 * s.width as u64 + x as u64;
-    let mut sampler = Sampler::for_pixel(s.seed, index, pass);
     let mut sum = Rgb::ZERO;
-    for _ in 0..s.spp {
+    for i in 0..s.spp as u64 {
+        let mut sampler = Sampler::for_pixel(s.seed, index, pass * s.spp as u64 + i);
         let film = Vec2::new(x as f32, y as f32) + sampler.next2();
         let lens = sampler.next2();
         let ray = scene.camera.ray(film, s.width, s.height, lens);

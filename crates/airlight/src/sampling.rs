@@ -21,9 +21,10 @@ fn mix64(mut z: u64) -> u64 {
 }
 
 impl Sampler {
-    /// The generator of one pixel in one pass of a render with this seed.
-    pub fn for_pixel(seed: u64, pixel: u64, pass: u64) -> Self {
-        let key = mix64(mix64(mix64(seed) ^ pixel) ^ pass.wrapping_mul(0x9e37_79b9_7f4a_7c15));
+    /// The generator of one sample (`sample`: its number across all passes)
+    /// of one pixel of a render with this seed.
+    pub fn for_pixel(seed: u64, pixel: u64, sample: u64) -> Self {
+        let key = mix64(mix64(mix64(seed) ^ pixel) ^ sample.wrapping_mul(0x9e37_79b9_7f4a_7c15));
         Self {
             rng: Pcg32::seed_from_u64(key),
         }
