@@ -14,11 +14,7 @@ use std::time::Instant;
 const DEMO_SCENE: &str = include_str!("../../../scenes/demo.toml");
 
 #[derive(Parser)]
-#[command(
-    name = "airlight",
-    version,
-    about = "Renders light that you can see: glows, light cones, volumetric shadows"
-)]
+#[command(name = "airlight", version, about = "Renders light that you can see: glows, light cones, volumetric shadows")]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -76,11 +72,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Render(args) => render(args),
         Command::Info { scene } => info(&scene),
-        Command::Compare {
-            image,
-            reference,
-            map,
-        } => compare(&image, &reference, map.as_deref()),
+        Command::Compare { image, reference, map } => compare(&image, &reference, map.as_deref()),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -94,9 +86,7 @@ fn main() -> ExitCode {
 fn load(path: Option<&Path>) -> Result<Scene, String> {
     match path {
         Some(path) => scene::load(path).map_err(|e| e.to_string()),
-        None => {
-            scene::from_toml_str(DEMO_SCENE, None).map_err(|e| format!("built-in demo scene: {e}"))
-        }
+        None => scene::from_toml_str(DEMO_SCENE, None).map_err(|e| format!("built-in demo scene: {e}")),
     }
 }
 
@@ -130,18 +120,10 @@ fn render(args: RenderArgs) -> Result<(), String> {
         args.output
     };
     for out in &outputs {
-        match out
-            .extension()
-            .and_then(|e| e.to_str())
-            .map(str::to_ascii_lowercase)
-            .as_deref()
-        {
+        match out.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref() {
             Some("png" | "exr") => {}
             _ => {
-                return Err(format!(
-                    "cannot write `{}`: the output must end in .png or .exr",
-                    out.display()
-                ));
+                return Err(format!("cannot write `{}`: the output must end in .png or .exr", out.display()));
             }
         }
     }
@@ -157,38 +139,22 @@ fn render(args: RenderArgs) -> Result<(), String> {
     } else {
         ProgressBar::with_draw_target(Some(pixels), ProgressDrawTarget::stderr())
     };
-    if let Ok(style) =
-        ProgressStyle::with_template("{spinner} {msg} [{bar:40}] {percent}% {elapsed} (eta {eta})")
-    {
+    if let Ok(style) = ProgressStyle::with_template("{spinner} {msg} [{bar:40}] {percent}% {elapsed} (eta {eta})") {
         bar.set_style(style.progress_chars("=> "));
     }
-    bar.set_message(format!(
-        "{} {}×{} {} spp",
-        s.integrator, s.width, s.height, s.spp
-    ));
+    bar.set_message(format!("{} {}×{} {} spp", s.integrator, s.width, s.height, s.spp));
     let progress = |n: u64| bar.inc(n);
-    let observer = RenderObserver {
-        progress: Some(&progress),
-        cancel: None,
-    };
+    let observer = RenderObserver { progress: Some(&progress), cancel: None };
     let start = Instant::now();
     let image = pool.install(|| render_with(&scene, integrator.as_ref(), &observer));
     let elapsed = start.elapsed();
     bar.finish_and_clear();
     for out in &outputs {
-        image
-            .write(out, s.exposure, s.tonemap)
-            .map_err(|e| format!("cannot write `{}`: {e}", out.display()))?;
+        image.write(out, s.exposure, s.tonemap).map_err(|e| format!("cannot write `{}`: {e}", out.display()))?;
     }
     if !args.quiet {
         let names: Vec<String> = outputs.iter().map(|p| p.display().to_string()).collect();
-        eprintln!(
-            "rendered {}×{} in {:.2} s → {}",
-            s.width,
-            s.height,
-            elapsed.as_secs_f64(),
-            names.join(", ")
-        );
+        eprintln!("rendered {}×{} in {:.2} s → {}", s.width, s.height, elapsed.as_secs_f64(), names.join(", "));
     }
     Ok(())
 }
@@ -197,10 +163,7 @@ fn info(path: &Path) -> Result<(), String> {
     let scene = load(Some(path))?;
     let s = &scene.settings;
     println!("scene: {}", path.display());
-    println!(
-        "image: {}×{}, {} spp, integrator {}",
-        s.width, s.height, s.spp, s.integrator
-    );
+    println!("image: {}×{}, {} spp, integrator {}", s.width, s.height, s.spp, s.integrator);
     println!(
         "camera: {:?} at {} looking along {}",
         scene.camera.projection, scene.camera.position, scene.camera.forward
@@ -221,8 +184,7 @@ fn info(path: &Path) -> Result<(), String> {
 
 fn compare(a: &Path, b: &Path, map: Option<&Path>) -> Result<(), String> {
     let image = Image::read_exr(a).map_err(|e| format!("cannot read `{}`: {e}", a.display()))?;
-    let reference =
-        Image::read_exr(b).map_err(|e| format!("cannot read `{}`: {e}", b.display()))?;
+    let reference = Image::read_exr(b).map_err(|e| format!("cannot read `{}`: {e}", b.display()))?;
     let e = film::compare(&image, &reference).ok_or_else(|| {
         format!(
             "the images differ in size: {}×{} and {}×{}",

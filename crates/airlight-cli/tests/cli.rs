@@ -4,11 +4,7 @@ use std::path::Path;
 use std::process::{Command, Output};
 
 fn airlight(dir: &Path, args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_airlight"))
-        .current_dir(dir)
-        .args(args)
-        .output()
-        .unwrap()
+    Command::new(env!("CARGO_BIN_EXE_airlight")).current_dir(dir).args(args).output().unwrap()
 }
 
 fn scenes() -> std::path::PathBuf {
@@ -19,11 +15,7 @@ fn scenes() -> std::path::PathBuf {
 fn render_with_no_arguments_writes_the_demo_to_airlight_png() {
     let dir = tempfile::tempdir().unwrap();
     let out = airlight(dir.path(), &["render", "--quiet"]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let png = image_size(&dir.path().join("airlight.png"));
     assert_eq!(png, (640, 480));
 }
@@ -41,25 +33,14 @@ fn thread_count_does_not_change_a_single_byte() {
     let dir = tempfile::tempdir().unwrap();
     let scene = scenes().join("demo.toml");
     let scene = scene.to_str().unwrap();
-    let common = [
-        "render", scene, "--width", "96", "--height", "64", "--spp", "2", "--quiet",
-    ];
-    let one = airlight(
-        dir.path(),
-        &[&common[..], &["--threads", "1", "-o", "one.exr"]].concat(),
-    );
-    let two = airlight(
-        dir.path(),
-        &[&common[..], &["--threads", "2", "-o", "two.exr"]].concat(),
-    );
+    let common = ["render", scene, "--width", "96", "--height", "64", "--spp", "2", "--quiet"];
+    let one = airlight(dir.path(), &[&common[..], &["--threads", "1", "-o", "one.exr"]].concat());
+    let two = airlight(dir.path(), &[&common[..], &["--threads", "2", "-o", "two.exr"]].concat());
     assert!(one.status.success() && two.status.success());
     let a = std::fs::read(dir.path().join("one.exr")).unwrap();
     let b = std::fs::read(dir.path().join("two.exr")).unwrap();
     assert!(a.len() > 1000);
-    assert!(
-        a == b,
-        "EXR bytes differ between --threads 1 and --threads 2"
-    );
+    assert!(a == b, "EXR bytes differ between --threads 1 and --threads 2");
 }
 
 #[test]
@@ -70,52 +51,37 @@ fn compare_prints_the_four_measures_and_a_map() {
     for (seed, name) in [("1", "a.exr"), ("2", "b.exr")] {
         let out = airlight(
             dir.path(),
-            &[
-                "render", scene, "--width", "48", "--height", "32", "--spp", "1", "--seed", seed,
-                "-o", name, "-q",
-            ],
+            &["render", scene, "--width", "48", "--height", "32", "--spp", "1", "--seed", seed, "-o", name, "-q"],
         );
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     }
-    let out = airlight(
-        dir.path(),
-        &["compare", "a.exr", "b.exr", "--map", "map.png"],
-    );
+    let out = airlight(dir.path(), &["compare", "a.exr", "b.exr", "--map", "map.png"]);
     assert!(out.status.success());
     let text = String::from_utf8(out.stdout).unwrap();
     for key in ["rmse: ", "rel_mse: ", "mae: ", "max: "] {
-        let line = text
-            .lines()
-            .find(|l| l.starts_with(key))
-            .unwrap_or_else(|| panic!("no `{key}` in {text}"));
+        let line = text.lines().find(|l| l.starts_with(key)).unwrap_or_else(|| panic!("no `{key}` in {text}"));
         let value: f64 = line[key.len()..].parse().unwrap();
         assert!(value.is_finite() && value >= 0.0);
     }
     assert!(dir.path().join("map.png").exists());
     // An image against itself: all zero.
-    let same =
-        String::from_utf8(airlight(dir.path(), &["compare", "a.exr", "a.exr"]).stdout).unwrap();
-    assert!(
-        same.contains("rmse: 0\n") && same.contains("max: 0\n"),
-        "{same}"
-    );
+    let same = String::from_utf8(airlight(dir.path(), &["compare", "a.exr", "a.exr"]).stdout).unwrap();
+    assert!(same.contains("rmse: 0\n") && same.contains("max: 0\n"), "{same}");
 }
 
 #[test]
 fn a_bad_scene_names_file_line_and_column_and_writes_nothing() {
     let dir = tempfile::tempdir().unwrap();
-    std::fs::write(dir.path().join("bad.toml"), "[render]\nwidth = 64\n\n[[objects]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = -2\nmaterial = \"m\"\n").unwrap();
+    std::fs::write(
+        dir.path().join("bad.toml"),
+        "[render]\nwidth = 64\n\n[[objects]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = -2\nmaterial = \"m\"\n",
+    )
+    .unwrap();
     let out = airlight(dir.path(), &["render", "bad.toml", "-o", "bad.png"]);
     assert!(!out.status.success());
     let err = String::from_utf8(out.stderr).unwrap();
     assert!(
-        err.contains(
-            "bad.toml:7:10: objects[0] (sphere).radius must be a positive finite number, got -2"
-        ),
+        err.contains("bad.toml:7:10: objects[0] (sphere).radius must be a positive finite number, got -2"),
         "{err}"
     );
     assert!(!dir.path().join("bad.png").exists());
@@ -137,11 +103,7 @@ fn bad_options_are_refused_before_rendering() {
         assert!(!out.status.success(), "{args:?} should fail");
         assert!(!out.stderr.is_empty());
     }
-    assert_eq!(
-        std::fs::read_dir(dir.path()).unwrap().count(),
-        0,
-        "nothing written"
-    );
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0, "nothing written");
 }
 
 #[test]
@@ -149,8 +111,5 @@ fn info_describes_a_scene() {
     let out = airlight(&scenes(), &["info", "spot_spheres.toml"]);
     assert!(out.status.success());
     let text = String::from_utf8(out.stdout).unwrap();
-    assert!(
-        text.contains("640×480") && text.contains("lights: 1"),
-        "{text}"
-    );
+    assert!(text.contains("640×480") && text.contains("lights: 1"), "{text}");
 }

@@ -19,14 +19,8 @@ fn displaced_sphere(n: u32) -> Shape {
         let theta = std::f32::consts::PI * i as f32 / n as f32;
         for j in 0..=n {
             let phi = 2.0 * std::f32::consts::PI * j as f32 / n as f32;
-            let dir = vec3(
-                theta.sin() * phi.cos(),
-                theta.cos(),
-                theta.sin() * phi.sin(),
-            );
-            let r = 1.0
-                + 0.05 * (7.0 * theta).sin() * (9.0 * phi).sin()
-                + 0.02 * (31.0 * theta + 3.0 * phi).sin();
+            let dir = vec3(theta.sin() * phi.cos(), theta.cos(), theta.sin() * phi.sin());
+            let r = 1.0 + 0.05 * (7.0 * theta).sin() * (9.0 * phi).sin() + 0.02 * (31.0 * theta + 3.0 * phi).sin();
             positions.push(dir * r);
         }
     }
@@ -39,22 +33,14 @@ fn displaced_sphere(n: u32) -> Shape {
             triangles.push([a + 1, b, b + 1]);
         }
     }
-    Shape::Mesh {
-        positions,
-        triangles,
-    }
+    Shape::Mesh { positions, triangles }
 }
 
 fn main() {
-    let n: u32 = std::env::args()
-        .nth(1)
-        .and_then(|a| a.parse().ok())
-        .unwrap_or(750);
+    let n: u32 = std::env::args().nth(1).and_then(|a| a.parse().ok()).unwrap_or(750);
     let t = Instant::now();
     let mesh = displaced_sphere(n);
-    let Shape::Mesh { triangles, .. } = &mesh else {
-        unreachable!()
-    };
+    let Shape::Mesh { triangles, .. } = &mesh else { unreachable!() };
     let tris = triangles.len();
     let mut builder = GeometryBuilder::default();
     builder.add(&mesh, 0, None);
@@ -76,12 +62,7 @@ fn main() {
         for tx in (0..w).step_by(16) {
             for y in ty..ty + 16 {
                 for x in tx..tx + 16 {
-                    rays.push(camera.ray(
-                        Vec2::new(x as f32 + 0.5, y as f32 + 0.5),
-                        w,
-                        h,
-                        Vec2::ZERO,
-                    ));
+                    rays.push(camera.ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5), w, h, Vec2::ZERO));
                 }
             }
         }
@@ -93,10 +74,7 @@ fn main() {
     let hits1: u64 = rays.iter().map(trace).sum();
     let one = t.elapsed().as_secs_f64();
     let t = Instant::now();
-    let hits2: u64 = rays
-        .par_chunks(256)
-        .map(|c| c.iter().map(trace).sum::<u64>())
-        .sum();
+    let hits2: u64 = rays.par_chunks(256).map(|c| c.iter().map(trace).sum::<u64>()).sum();
     let all = t.elapsed().as_secs_f64();
     assert_eq!(hits1, hits2);
     let _ = hits;

@@ -33,33 +33,18 @@ pub const ISOMETRIC_VIEW: Vec3 = Vec3::new(-0.577_350_3, -0.577_350_3, -0.577_35
 impl Camera {
     /// A pinhole perspective camera at `position` looking at `target`.
     pub fn look_at(position: Vec3, target: Vec3, up: Vec3, fov_degrees: f32) -> Self {
-        Self::oriented(
-            position,
-            target,
-            up,
-            Projection::Perspective { fov_degrees },
-        )
+        Self::oriented(position, target, up, Projection::Perspective { fov_degrees })
     }
 
     /// An orthographic camera at `position` looking at `target`.
     pub fn orthographic(position: Vec3, target: Vec3, up: Vec3, view_height: f32) -> Self {
-        Self::oriented(
-            position,
-            target,
-            up,
-            Projection::Orthographic { view_height },
-        )
+        Self::oriented(position, target, up, Projection::Orthographic { view_height })
     }
 
     /// The isometric view of `target`: orthographic, looking along
     /// (−1, −1, −1) from `distance` away, y up on screen.
     pub fn isometric(target: Vec3, view_height: f32, distance: f32) -> Self {
-        Self::orthographic(
-            target - ISOMETRIC_VIEW * distance,
-            target,
-            Vec3::Y,
-            view_height,
-        )
+        Self::orthographic(target - ISOMETRIC_VIEW * distance, target, Vec3::Y, view_height)
     }
 
     /// Frames a camera; `up` need only not be parallel to the view direction.
@@ -95,14 +80,12 @@ impl Camera {
         let (origin, dir) = match self.projection {
             Projection::Perspective { fov_degrees } => {
                 let half = (0.5 * fov_degrees.to_radians()).tan();
-                let d =
-                    self.forward + self.right * (ndc_x * half * aspect) + self.up * (ndc_y * half);
+                let d = self.forward + self.right * (ndc_x * half * aspect) + self.up * (ndc_y * half);
                 (self.position, d.normalize())
             }
             Projection::Orthographic { view_height } => {
                 let half = 0.5 * view_height;
-                let o =
-                    self.position + self.right * (ndc_x * half * aspect) + self.up * (ndc_y * half);
+                let o = self.position + self.right * (ndc_x * half * aspect) + self.up * (ndc_y * half);
                 (o, self.forward)
             }
         };
@@ -124,22 +107,14 @@ mod tests {
 
     #[test]
     fn centre_ray_looks_forward_and_right_is_forward_cross_up() {
-        let cam = Camera::look_at(
-            Vec3::new(0.0, 2.0, -6.0),
-            Vec3::new(0.0, 2.0, 0.0),
-            Vec3::Y,
-            40.0,
-        );
+        let cam = Camera::look_at(Vec3::new(0.0, 2.0, -6.0), Vec3::new(0.0, 2.0, 0.0), Vec3::Y, 40.0);
         let r = cam.ray(Vec2::new(32.0, 24.0), 64, 48, Vec2::ZERO);
         assert!((r.dir - Vec3::Z).length() < 1e-6);
         // Looking down +z with y up, forward × up = z × y = −x: the image's right.
         assert!((cam.right - Vec3::NEG_X).length() < 1e-6);
         let top = cam.ray(Vec2::new(32.0, 0.0), 64, 48, Vec2::ZERO);
         let angle = top.dir.angle_between(Vec3::Z).to_degrees();
-        assert!(
-            (angle - 20.0).abs() < 1e-3,
-            "half the vertical fov: {angle}"
-        );
+        assert!((angle - 20.0).abs() < 1e-3, "half the vertical fov: {angle}");
         assert!(top.dir.y > 0.0, "row 0 is the top");
     }
 

@@ -17,11 +17,7 @@ pub struct Image {
 
 impl Image {
     pub fn new(width: u32, height: u32) -> Self {
-        Image {
-            width,
-            height,
-            pixels: vec![Rgb::ZERO; width as usize * height as usize],
-        }
+        Image { width, height, pixels: vec![Rgb::ZERO; width as usize * height as usize] }
     }
 
     #[inline]
@@ -40,20 +36,14 @@ impl Image {
     /// target under a temporary name and renamed, so a failure never leaves
     /// a partial image.
     pub fn write(&self, path: &Path, exposure: f32, tonemap: Tonemap) -> io::Result<()> {
-        let ext = path
-            .extension()
-            .and_then(|e| e.to_str())
-            .map(str::to_ascii_lowercase);
+        let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
         let bytes = match ext.as_deref() {
             Some("exr") => self.encode_exr()?,
             Some("png") => self.encode_png(exposure, tonemap)?,
             _ => {
                 return Err(io::Error::new(
                     io::ErrorKind::InvalidInput,
-                    format!(
-                        "cannot tell the image format of `{}`: use .exr or .png",
-                        path.display()
-                    ),
+                    format!("cannot tell the image format of `{}`: use .exr or .png", path.display()),
                 ));
             }
         };
@@ -69,18 +59,12 @@ impl Image {
         });
         // Lines in increasing order: the default lets parallel compression
         // write blocks as they finish, so the bytes would vary run to run.
-        let encoding = Encoding {
-            compression: Compression::ZIP16,
-            blocks: Blocks::ScanLines,
-            line_order: LineOrder::Increasing,
-        };
+        let encoding =
+            Encoding { compression: Compression::ZIP16, blocks: Blocks::ScanLines, line_order: LineOrder::Increasing };
         let layer = Layer::new((w, h), LayerAttributes::default(), encoding, channels);
         let image = exr::prelude::Image::from_layer(layer);
         let mut out = io::Cursor::new(Vec::new());
-        image
-            .write()
-            .to_buffered(&mut out)
-            .map_err(io::Error::other)?;
+        image.write().to_buffered(&mut out).map_err(io::Error::other)?;
         Ok(out.into_inner())
     }
 
@@ -114,19 +98,10 @@ impl Image {
                 pixels[pos.y() * *stride + pos.x()] = Rgb::new(r, g, b)
             },
         )
-        .map_err(|e| {
-            io::Error::new(
-                io::ErrorKind::InvalidData,
-                format!("{}: {e}", path.display()),
-            )
-        })?;
+        .map_err(|e| io::Error::new(io::ErrorKind::InvalidData, format!("{}: {e}", path.display())))?;
         let size = image.layer_data.size;
         let (_, pixels) = image.layer_data.channel_data.pixels;
-        Ok(Self {
-            width: size.x() as u32,
-            height: size.y() as u32,
-            pixels,
-        })
+        Ok(Self { width: size.x() as u32, height: size.y() as u32, pixels })
     }
 }
 
@@ -136,29 +111,21 @@ pub fn tone(x: f32, tonemap: Tonemap) -> f32 {
     match tonemap {
         Tonemap::Clamp => x.min(1.0),
         // Narkowicz, "ACES Filmic Tone Mapping Curve" (2015).
-        Tonemap::Filmic => {
-            ((x * (2.51 * x + 0.03)) / (x * (2.43 * x + 0.59) + 0.14)).clamp(0.0, 1.0)
-        }
+        Tonemap::Filmic => ((x * (2.51 * x + 0.03)) / (x * (2.43 * x + 0.59) + 0.14)).clamp(0.0, 1.0),
     }
 }
 
 /// The sRGB transfer function (IEC 61966-2-1) to 8 bits.
 pub fn to_srgb8(linear: f32) -> u8 {
     let v = linear.clamp(0.0, 1.0);
-    let s = if v <= 0.003_130_8 {
-        12.92 * v
-    } else {
-        1.055 * v.powf(1.0 / 2.4) - 0.055
-    };
+    let s = if v <= 0.003_130_8 { 12.92 * v } else { 1.055 * v.powf(1.0 / 2.4) - 0.055 };
     (s * 255.0 + 0.5) as u8
 }
 
 /// Writes `bytes` to `path` through a temporary file in the same directory
 /// and a rename, so readers see the old file or the whole new one.
 pub fn write_atomically(path: &Path, bytes: &[u8]) -> io::Result<()> {
-    let name = path
-        .file_name()
-        .ok_or_else(|| io::Error::new(io::ErrorKind::InvalidInput, "no file name"))?;
+    let name = path.file_name().ok_or_else(|| io::Error::new(io::ErrorKind::InvalidInput, "no file name"))?;
     let mut tmp_name = std::ffi::OsString::from(".");
     tmp_name.push(name);
     tmp_name.push(format!(".tmp-{}", std::process::id()));
@@ -229,11 +196,7 @@ pub fn error_map(image: &Image, reference: &Image, scale: f32) -> Image {
         .zip(&reference.pixels)
         .map(|(a, b)| Rgb::splat(((*a - *b).abs().element_sum() / 3.0) / scale.max(1e-30)))
         .collect();
-    Image {
-        width: image.width,
-        height: image.height,
-        pixels,
-    }
+    Image { width: image.width, height: image.height, pixels }
 }
 
 #[cfg(test)]
@@ -260,11 +223,7 @@ mod tests {
         let path = dir.path().join("missing-dir").join("a.png");
         assert!(Image::new(2, 2).write(&path, 0.0, Tonemap::Clamp).is_err());
         assert!(!path.exists());
-        assert!(
-            Image::new(2, 2)
-                .write(&dir.path().join("a.tiff"), 0.0, Tonemap::Clamp)
-                .is_err()
-        );
+        assert!(Image::new(2, 2).write(&dir.path().join("a.tiff"), 0.0, Tonemap::Clamp).is_err());
         assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
     }
 
@@ -279,16 +238,8 @@ mod tests {
 
     #[test]
     fn compare_measures_known_differences() {
-        let a = Image {
-            width: 2,
-            height: 1,
-            pixels: vec![Rgb::splat(1.0), Rgb::splat(0.0)],
-        };
-        let b = Image {
-            width: 2,
-            height: 1,
-            pixels: vec![Rgb::splat(1.0), Rgb::splat(0.5)],
-        };
+        let a = Image { width: 2, height: 1, pixels: vec![Rgb::splat(1.0), Rgb::splat(0.0)] };
+        let b = Image { width: 2, height: 1, pixels: vec![Rgb::splat(1.0), Rgb::splat(0.5)] };
         let e = compare(&a, &b).unwrap();
         assert!((e.rmse - (0.125f64).sqrt()).abs() < 1e-12);
         assert!((e.mae - 0.25).abs() < 1e-12);

@@ -9,20 +9,12 @@ pub enum Material {
     /// Lambertian: BRDF = albedo/π.
     Diffuse { albedo: Rgb },
     /// A solid checkerboard of two Lambertian albedos, squares `scale` wide.
-    Checker {
-        albedo: Rgb,
-        albedo2: Rgb,
-        scale: f32,
-    },
+    Checker { albedo: Rgb, albedo2: Rgb, scale: f32 },
     /// Diffuse plus a normalised Phong lobe (Lafortune and Willems 1994):
     /// f = albedo/π + specular·(n+2)/(2π)·max(0, r·wi)^n, r the mirror of wo.
     /// The (n+2)/(2π) makes the lobe's directional albedo at normal
     /// incidence equal `specular`, as in the seed's setUpPhongIllumination.
-    Phong {
-        albedo: Rgb,
-        specular: Rgb,
-        exponent: f32,
-    },
+    Phong { albedo: Rgb, specular: Rgb, exponent: f32 },
 }
 
 impl Material {
@@ -30,18 +22,10 @@ impl Material {
         Material::Diffuse { albedo }
     }
     pub fn checker(albedo: Rgb, albedo2: Rgb, scale: f32) -> Self {
-        Material::Checker {
-            albedo,
-            albedo2,
-            scale,
-        }
+        Material::Checker { albedo, albedo2, scale }
     }
     pub fn phong(albedo: Rgb, specular: Rgb, exponent: f32) -> Self {
-        Material::Phong {
-            albedo,
-            specular,
-            exponent,
-        }
+        Material::Phong { albedo, specular, exponent }
     }
     /// The black surface of an area light.
     pub const BLACK: Material = Material::Diffuse { albedo: Rgb::ZERO };
@@ -50,20 +34,12 @@ impl Material {
     pub fn albedo(&self, p: Vec3, n: Vec3) -> Rgb {
         match *self {
             Material::Diffuse { albedo } | Material::Phong { albedo, .. } => albedo,
-            Material::Checker {
-                albedo,
-                albedo2,
-                scale,
-            } => {
+            Material::Checker { albedo, albedo2, scale } => {
                 // Step half a square inward so that points on a face that lies
                 // on a cell boundary (a floor at y = 0) all fall in one cell.
                 let q = (p - n * (0.5 * scale)) / scale;
                 let parity = q.x.floor() as i64 + q.y.floor() as i64 + q.z.floor() as i64;
-                if parity.rem_euclid(2) == 0 {
-                    albedo
-                } else {
-                    albedo2
-                }
+                if parity.rem_euclid(2) == 0 { albedo } else { albedo2 }
             }
         }
     }
@@ -73,9 +49,7 @@ impl Material {
     pub fn brdf(&self, p: Vec3, n: Vec3, wo: Vec3, wi: Vec3) -> Rgb {
         let diffuse = self.albedo(p, n) / PI;
         match *self {
-            Material::Phong {
-                specular, exponent, ..
-            } => {
+            Material::Phong { specular, exponent, .. } => {
                 // Both directions on one side of the surface, for the lobe.
                 let n = if n.dot(wo) < 0.0 { -n } else { n };
                 if n.dot(wi) <= 0.0 {

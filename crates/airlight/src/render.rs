@@ -46,9 +46,7 @@ pub fn render_with(scene: &Scene, integrator: &dyn Integrator, observer: &Render
     let s = &scene.settings;
     let (w, h) = (s.width, s.height);
     let tiles_x = w.div_ceil(TILE);
-    let tiles: Vec<(u32, u32)> = (0..h.div_ceil(TILE))
-        .flat_map(|ty| (0..tiles_x).map(move |tx| (tx, ty)))
-        .collect();
+    let tiles: Vec<(u32, u32)> = (0..h.div_ceil(TILE)).flat_map(|ty| (0..tiles_x).map(move |tx| (tx, ty))).collect();
     let rendered: Vec<Vec<Rgb>> = tiles
         .par_iter()
         .map(|&(tx, ty)| {

@@ -25,9 +25,7 @@ impl Sampler {
     /// of one pixel of a render with this seed.
     pub fn for_pixel(seed: u64, pixel: u64, sample: u64) -> Self {
         let key = mix64(mix64(mix64(seed) ^ pixel) ^ sample.wrapping_mul(0x9e37_79b9_7f4a_7c15));
-        Self {
-            rng: Pcg32::seed_from_u64(key),
-        }
+        Self { rng: Pcg32::seed_from_u64(key) }
     }
 
     #[inline]
@@ -39,6 +37,23 @@ impl Sampler {
     pub fn next2(&mut self) -> Vec2 {
         Vec2::new(self.next(), self.next())
     }
+
+    /// A random 64-bit key, for [`keyed2`].
+    #[inline]
+    pub fn next_key(&mut self) -> u64 {
+        self.rng.random::<u64>()
+    }
+}
+
+/// Two uniform numbers in [0, 1) for item `index` under `key`: a
+/// counter-based draw, so that what item i gets does not depend on which
+/// other items were drawn (lights culled at one point and not another).
+#[inline]
+pub fn keyed2(key: u64, index: u64) -> Vec2 {
+    let bits = mix64(key ^ index.wrapping_mul(0x9e37_79b9_7f4a_7c15).wrapping_add(0x632b_e59b_d9b4_e019));
+    // The top 24 bits of each half make floats exact in [0, 1).
+    let scale = 1.0 / (1u32 << 24) as f32;
+    Vec2::new((bits >> 40) as f32 * scale, ((bits >> 8) & 0xff_ffff) as f32 * scale)
 }
 
 /// An orthonormal basis (t, b, n) around a unit vector n, by the branchless
@@ -49,10 +64,7 @@ pub fn basis(n: Vec3) -> (Vec3, Vec3) {
     let sign = 1.0f32.copysign(n.z);
     let a = -1.0 / (sign + n.z);
     let b = n.x * n.y * a;
-    (
-        Vec3::new(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x),
-        Vec3::new(b, sign + n.y * n.y * a, -n.y),
-    )
+    (Vec3::new(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x), Vec3::new(b, sign + n.y * n.y * a, -n.y))
 }
 
 /// Expresses local (x, y, z) in the frame whose z axis is `n`.
@@ -68,11 +80,8 @@ pub fn concentric_disk(u: Vec2) -> Vec2 {
     if o == Vec2::ZERO {
         return Vec2::ZERO;
     }
-    let (r, theta) = if o.x.abs() > o.y.abs() {
-        (o.x, PI / 4.0 * (o.y / o.x))
-    } else {
-        (o.y, PI / 2.0 - PI / 4.0 * (o.x / o.y))
-    };
+    let (r, theta) =
+        if o.x.abs() > o.y.abs() { (o.x, PI / 4.0 * (o.y / o.x)) } else { (o.y, PI / 2.0 - PI / 4.0 * (o.x / o.y)) };
     Vec2::new(r * theta.cos(), r * theta.sin())
 }
 

@@ -21,12 +21,7 @@ fn diffuse_plane_under_point_light_matches_inverse_square_law() {
         .build()
         .unwrap();
     let mut sampler = Sampler::for_pixel(0, 0, 0);
-    for target in [
-        vec3(0.0, 0.0, 0.0),
-        vec3(2.5, 0.0, 3.0),
-        vec3(-3.0, 0.0, 1.0),
-        vec3(0.7, 0.0, -2.0),
-    ] {
+    for target in [vec3(0.0, 0.0, 0.0), vec3(2.5, 0.0, 3.0), vec3(-3.0, 0.0, 1.0), vec3(0.7, 0.0, -2.0)] {
         let ray = Ray::new(eye, (target - eye).normalize());
         let got = Direct.radiance(&scene, &ray, &mut sampler);
         let to_light = light_pos.as_dvec3() - target.as_dvec3();
@@ -35,11 +30,7 @@ fn diffuse_plane_under_point_light_matches_inverse_square_law() {
         for c in 0..3 {
             let expected = intensity[c] as f64 * cos / d2 * albedo[c] as f64 / std::f64::consts::PI;
             let rel = (got[c] as f64 / expected - 1.0).abs();
-            assert!(
-                rel < 1e-4,
-                "at {target}: channel {c}: {} vs {expected} ({rel:e})",
-                got[c]
-            );
+            assert!(rel < 1e-4, "at {target}: channel {c}: {} vs {expected} ({rel:e})", got[c]);
         }
     }
 }
@@ -51,14 +42,7 @@ fn shadowed_points_are_black_and_two_sided_surfaces_reflect() {
     let scene = SceneBuilder::new()
         .material("m", Material::diffuse(Rgb::splat(0.5)))
         .object(Shape::plane(Vec3::ZERO, Vec3::Y), "m")
-        .object(
-            Shape::quad(
-                vec3(-1.0, 1.0, -1.0),
-                vec3(0.0, 0.0, 2.0),
-                vec3(2.0, 0.0, 0.0),
-            ),
-            "m",
-        )
+        .object(Shape::quad(vec3(-1.0, 1.0, -1.0), vec3(0.0, 0.0, 2.0), vec3(2.0, 0.0, 0.0)), "m")
         .light(Light::point(vec3(0.0, 3.0, 0.0), Rgb::splat(10.0)))
         .build()
         .unwrap();
@@ -80,34 +64,14 @@ fn busy_scene() -> Scene {
     SceneBuilder::new()
         .size(37, 23)
         .with_settings(|s| s.spp = 3)
-        .camera(
-            Camera::look_at(vec3(0.0, 2.0, -6.0), vec3(0.0, 0.5, 0.0), Vec3::Y, 50.0)
-                .with_lens(0.05, 6.0),
-        )
-        .material(
-            "floor",
-            Material::checker(Rgb::splat(0.8), Rgb::splat(0.1), 0.5),
-        )
-        .material(
-            "shiny",
-            Material::phong(Rgb::new(0.2, 0.3, 0.8), Rgb::splat(0.3), 30.0),
-        )
+        .camera(Camera::look_at(vec3(0.0, 2.0, -6.0), vec3(0.0, 0.5, 0.0), Vec3::Y, 50.0).with_lens(0.05, 6.0))
+        .material("floor", Material::checker(Rgb::splat(0.8), Rgb::splat(0.1), 0.5))
+        .material("shiny", Material::phong(Rgb::new(0.2, 0.3, 0.8), Rgb::splat(0.3), 30.0))
         .object(Shape::plane(Vec3::ZERO, Vec3::Y), "floor")
         .object(Shape::sphere(vec3(0.0, 1.0, 0.0), 1.0), "shiny")
-        .light(Light::quad(
-            vec3(-1.0, 4.0, -1.0),
-            vec3(2.0, 0.0, 0.0),
-            vec3(0.0, 0.0, 2.0),
-            Rgb::splat(5.0),
-        ))
+        .light(Light::quad(vec3(-1.0, 4.0, -1.0), vec3(2.0, 0.0, 0.0), vec3(0.0, 0.0, 2.0), Rgb::splat(5.0)))
         .light(Light::sphere(vec3(2.0, 2.0, -1.0), 0.3, Rgb::splat(20.0)))
-        .light(Light::spot(
-            vec3(-2.0, 3.0, -1.0),
-            Vec3::ZERO,
-            Rgb::splat(30.0),
-            30.0,
-            20.0,
-        ))
+        .light(Light::spot(vec3(-2.0, 3.0, -1.0), Vec3::ZERO, Rgb::splat(30.0), 30.0, 20.0))
         .build()
         .unwrap()
 }
@@ -116,10 +80,7 @@ fn busy_scene() -> Scene {
 fn image_does_not_depend_on_thread_count() {
     let scene = busy_scene();
     let render_on = |threads| {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap();
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
         pool.install(|| render_with(&scene, &Direct, &RenderObserver::none()))
     };
     let one = render_on(1);

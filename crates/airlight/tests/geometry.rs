@@ -3,8 +3,7 @@
 //! against testing every primitive.
 
 use airlight::geometry::{
-    GeometryBuilder, Ray, Shape, intersect_box, intersect_quad, intersect_sphere,
-    intersect_triangle,
+    GeometryBuilder, Ray, Shape, intersect_box, intersect_quad, intersect_sphere, intersect_triangle,
 };
 use airlight::sampling::{Sampler, uniform_sphere};
 use glam::{Affine3A, DVec3, Quat, Vec3};
@@ -23,11 +22,7 @@ fn march_first_crossing(o: DVec3, d: DVec3, inside: impl Fn(DVec3) -> bool) -> O
             let (mut lo, mut hi) = (t - dt, t);
             for _ in 0..60 {
                 let mid = 0.5 * (lo + hi);
-                if inside(o + d * mid) == start {
-                    lo = mid
-                } else {
-                    hi = mid
-                }
+                if inside(o + d * mid) == start { lo = mid } else { hi = mid }
             }
             return Some(0.5 * (lo + hi));
         }
@@ -36,13 +31,7 @@ fn march_first_crossing(o: DVec3, d: DVec3, inside: impl Fn(DVec3) -> bool) -> O
 }
 
 /// First t where the segment crosses a plane at a point `accept` takes.
-fn plane_crossing(
-    o: DVec3,
-    d: DVec3,
-    point: DVec3,
-    n: DVec3,
-    accept: impl Fn(DVec3) -> bool,
-) -> Option<f64> {
+fn plane_crossing(o: DVec3, d: DVec3, point: DVec3, n: DVec3, accept: impl Fn(DVec3) -> bool) -> Option<f64> {
     let t = n.dot(point - o) / n.dot(d);
     (t > 0.0 && t < T_MAX && accept(o + d * t)).then_some(t)
 }
@@ -64,54 +53,29 @@ struct Case {
     worst: f64,
 }
 
-fn check(
-    name: &str,
-    rays: usize,
-    shape_t: impl Fn(Vec3, Vec3) -> f32,
-    oracle: impl Fn(DVec3, DVec3) -> Option<f64>,
-) {
+fn check(name: &str, rays: usize, shape_t: impl Fn(Vec3, Vec3) -> f32, oracle: impl Fn(DVec3, DVec3) -> Option<f64>) {
     let mut s = Sampler::for_pixel(42, name.len() as u64, 0);
-    let mut c = Case {
-        hits_agree: 0,
-        misses_agree: 0,
-        disagree: 0,
-        worst: 0.0,
-    };
+    let mut c = Case { hits_agree: 0, misses_agree: 0, disagree: 0, worst: 0.0 };
     for _ in 0..rays {
         let o = (Vec3::new(s.next(), s.next(), s.next()) - 0.5) * 6.0;
         // Aim near the origin, so most rays hit.
         let target = (Vec3::new(s.next(), s.next(), s.next()) - 0.5) * 2.5;
-        let d = if s.next() < 0.2 {
-            uniform_sphere(s.next2())
-        } else {
-            (target - o).normalize()
-        };
+        let d = if s.next() < 0.2 { uniform_sphere(s.next2()) } else { (target - o).normalize() };
         let t = shape_t(o, d);
         let expected = oracle(o.as_dvec3(), d.as_dvec3());
         match (t.is_finite(), expected) {
             (true, Some(e)) => {
                 let err = (t as f64 - e).abs();
                 c.worst = c.worst.max(err);
-                if err < 1e-3 {
-                    c.hits_agree += 1
-                } else {
-                    c.disagree += 1
-                }
+                if err < 1e-3 { c.hits_agree += 1 } else { c.disagree += 1 }
             }
             (false, None) => c.misses_agree += 1,
             _ => c.disagree += 1,
         }
     }
     // Grazing rays whose chord is shorter than the march step may disagree.
-    assert!(
-        c.disagree * 500 <= rays,
-        "{name}: {} of {rays} rays disagree",
-        c.disagree
-    );
-    assert!(
-        c.hits_agree > rays / 5 && c.misses_agree > rays / 20,
-        "{name}: too few hits or misses to mean much"
-    );
+    assert!(c.disagree * 500 <= rays, "{name}: {} of {rays} rays disagree", c.disagree);
+    assert!(c.hits_agree > rays / 5 && c.misses_agree > rays / 20, "{name}: too few hits or misses to mean much");
     assert!(c.worst < 1e-3, "{name}: worst distance error {}", c.worst);
 }
 
@@ -122,11 +86,7 @@ fn sphere_matches_oracle() {
         "sphere",
         3000,
         |o, d| intersect_sphere(c, r, o, d, 0.0, T_MAX as f32),
-        |o, d| {
-            march_first_crossing(o, d, |p| {
-                (p - c.as_dvec3()).length_squared() < (r as f64).powi(2)
-            })
-        },
+        |o, d| march_first_crossing(o, d, |p| (p - c.as_dvec3()).length_squared() < (r as f64).powi(2)),
     );
 }
 
@@ -137,21 +97,13 @@ fn box_matches_oracle() {
         "box",
         3000,
         |o, d| intersect_box(lo, hi, o, d, 0.0, T_MAX as f32),
-        |o, d| {
-            march_first_crossing(o, d, |p| {
-                p.cmpgt(lo.as_dvec3()).all() && p.cmplt(hi.as_dvec3()).all()
-            })
-        },
+        |o, d| march_first_crossing(o, d, |p| p.cmpgt(lo.as_dvec3()).all() && p.cmplt(hi.as_dvec3()).all()),
     );
 }
 
 #[test]
 fn quad_matches_oracle() {
-    let (corner, u, v) = (
-        Vec3::new(-1.0, -0.3, 0.2),
-        Vec3::new(2.0, 0.3, 0.1),
-        Vec3::new(-0.2, 1.5, 0.9),
-    );
+    let (corner, u, v) = (Vec3::new(-1.0, -0.3, 0.2), Vec3::new(2.0, 0.3, 0.1), Vec3::new(-0.2, 1.5, 0.9));
     let (cd, ud, vd) = (corner.as_dvec3(), u.as_dvec3(), v.as_dvec3());
     check(
         "quad",
@@ -168,11 +120,7 @@ fn quad_matches_oracle() {
 
 #[test]
 fn triangle_matches_oracle() {
-    let (a, b, c) = (
-        Vec3::new(-1.2, -0.5, 0.0),
-        Vec3::new(1.0, -0.8, 0.4),
-        Vec3::new(0.1, 1.3, -0.3),
-    );
+    let (a, b, c) = (Vec3::new(-1.2, -0.5, 0.0), Vec3::new(1.0, -0.8, 0.4), Vec3::new(0.1, 1.3, -0.3));
     let (ad, e1, e2) = (a.as_dvec3(), (b - a).as_dvec3(), (c - a).as_dvec3());
     check(
         "triangle",
@@ -192,11 +140,7 @@ fn through_geometry(shape: Shape) -> impl Fn(Vec3, Vec3) -> f32 {
     let mut builder = GeometryBuilder::default();
     builder.add(&shape, 0, None);
     let geometry = builder.build();
-    move |o, d| {
-        geometry
-            .intersect(&Ray::new(o, d), T_MAX as f32)
-            .map_or(f32::INFINITY, |h| h.t)
-    }
+    move |o, d| geometry.intersect(&Ray::new(o, d), T_MAX as f32).map_or(f32::INFINITY, |h| h.t)
 }
 
 #[test]
@@ -209,12 +153,9 @@ fn transformed_sphere_and_box_match_oracle() {
     );
     let inv = glam::Mat4::from(m.inverse()).as_dmat4();
     let local = |p: DVec3| inv.transform_point3(p);
-    check(
-        "ellipsoid",
-        2000,
-        through_geometry(Shape::sphere(Vec3::ZERO, 1.0).transformed(m)),
-        |o, d| march_first_crossing(o, d, |p| local(p).length_squared() < 1.0),
-    );
+    check("ellipsoid", 2000, through_geometry(Shape::sphere(Vec3::ZERO, 1.0).transformed(m)), |o, d| {
+        march_first_crossing(o, d, |p| local(p).length_squared() < 1.0)
+    });
     check(
         "rotated box",
         2000,
@@ -222,15 +163,8 @@ fn transformed_sphere_and_box_match_oracle() {
         |o, d| march_first_crossing(o, d, |p| local(p).abs().max_element() < 0.8),
     );
     // A uniformly scaled, rotated sphere stays a sphere of the scaled radius.
-    let similar = Affine3A::from_scale_rotation_translation(
-        Vec3::splat(2.0),
-        Quat::from_rotation_y(1.0),
-        Vec3::X,
-    );
-    assert_eq!(
-        Shape::sphere(Vec3::ZERO, 0.5).transformed(similar),
-        Shape::sphere(Vec3::X, 1.0)
-    );
+    let similar = Affine3A::from_scale_rotation_translation(Vec3::splat(2.0), Quat::from_rotation_y(1.0), Vec3::X);
+    assert_eq!(Shape::sphere(Vec3::ZERO, 0.5).transformed(similar), Shape::sphere(Vec3::X, 1.0));
 }
 
 #[test]
@@ -246,14 +180,7 @@ fn bvh_agrees_with_brute_force_on_a_triangle_soup() {
         triangles.push([3 * i, 3 * i + 1, 3 * i + 2]);
     }
     let mut builder = GeometryBuilder::default();
-    builder.add(
-        &Shape::Mesh {
-            positions,
-            triangles,
-        },
-        0,
-        None,
-    );
+    builder.add(&Shape::Mesh { positions, triangles }, 0, None);
     builder.add(&Shape::sphere(Vec3::new(1.0, 2.0, 0.0), 1.5), 0, None);
     builder.add(&Shape::plane(Vec3::new(0.0, -5.5, 0.0), Vec3::Y), 0, None);
     let geometry = builder.build();
@@ -262,20 +189,12 @@ fn bvh_agrees_with_brute_force_on_a_triangle_soup() {
         let o = (Vec3::new(s.next(), s.next(), s.next()) - 0.5) * 14.0;
         let d = uniform_sphere(s.next2());
         let ray = Ray::new(o, d);
-        let tmax = if s.next() < 0.5 {
-            f32::INFINITY
-        } else {
-            4.0 * s.next()
-        };
+        let tmax = if s.next() < 0.5 { f32::INFINITY } else { 4.0 * s.next() };
         let fast = geometry.intersect(&ray, tmax);
         let slow = geometry.intersect_brute_force(&ray, tmax);
         assert_eq!(fast.map(|h| h.t), slow.map(|h| h.t), "ray {o} {d}");
         assert_eq!(geometry.occluded(o, d, tmax), slow.is_some());
-        if slow.is_some() {
-            hits += 1
-        } else {
-            misses += 1
-        }
+        if slow.is_some() { hits += 1 } else { misses += 1 }
     }
     assert!(hits > 500 && misses > 500, "hits {hits} misses {misses}");
 }
@@ -288,47 +207,23 @@ fn axis_aligned_rays_find_flat_quads_through_the_bvh() {
     for i in 0..7 {
         let y = i as f32 * 1.5;
         builder.add(
-            &Shape::quad(
-                Vec3::new(-1.0, y, -1.0),
-                Vec3::new(0.0, 0.0, 2.0),
-                Vec3::new(2.0, 0.0, 0.0),
-            ),
+            &Shape::quad(Vec3::new(-1.0, y, -1.0), Vec3::new(0.0, 0.0, 2.0), Vec3::new(2.0, 0.0, 0.0)),
             0,
             None,
         );
         builder.add(
-            &Shape::quad(
-                Vec3::new(3.0 + y, -1.0, -1.0),
-                Vec3::new(0.0, 2.0, 0.0),
-                Vec3::new(0.0, 0.0, 2.0),
-            ),
+            &Shape::quad(Vec3::new(3.0 + y, -1.0, -1.0), Vec3::new(0.0, 2.0, 0.0), Vec3::new(0.0, 0.0, 2.0)),
             0,
             None,
         );
     }
     let geometry = builder.build();
-    for dir in [
-        Vec3::X,
-        Vec3::NEG_X,
-        Vec3::Y,
-        Vec3::NEG_Y,
-        Vec3::Z,
-        Vec3::NEG_Z,
-        -Vec3::Y,
-        -Vec3::X,
-    ] {
-        for origin in [
-            Vec3::new(0.2, 4.0, 0.1),
-            Vec3::new(-5.0, 0.3, 0.2),
-            Vec3::new(20.0, 0.1, -0.4),
-            Vec3::new(0.0, 20.0, 0.0),
-        ] {
+    for dir in [Vec3::X, Vec3::NEG_X, Vec3::Y, Vec3::NEG_Y, Vec3::Z, Vec3::NEG_Z, -Vec3::Y, -Vec3::X] {
+        for origin in
+            [Vec3::new(0.2, 4.0, 0.1), Vec3::new(-5.0, 0.3, 0.2), Vec3::new(20.0, 0.1, -0.4), Vec3::new(0.0, 20.0, 0.0)]
+        {
             let ray = Ray::new(origin, dir);
-            assert_eq!(
-                geometry.intersect(&ray, 100.0),
-                geometry.intersect_brute_force(&ray, 100.0),
-                "{origin} {dir}"
-            );
+            assert_eq!(geometry.intersect(&ray, 100.0), geometry.intersect_brute_force(&ray, 100.0), "{origin} {dir}");
         }
     }
     let down = Ray::new(Vec3::new(0.2, 4.0, 0.1), -Vec3::Y);

@@ -31,62 +31,28 @@ fn cases() -> Vec<(String, usize, &'static str)> {
     let with = |head: &str| format!("{head}\n{GOOD_TAIL}");
     vec![
         // 1. Not TOML at all.
-        (
-            "[render\nwidth = 3".into(),
-            1,
-            "unclosed table, expected `]`",
-        ),
+        ("[render\nwidth = 3".into(), 1, "unclosed table, expected `]`"),
         // 2. A key without a value.
-        (
-            "[render]\nwidth =\n".into(),
-            2,
-            "string values must be quoted",
-        ),
+        ("[render]\nwidth =\n".into(), 2, "string values must be quoted"),
         // 3. Unknown top-level table.
         (with("[rendr]\nwidth = 4"), 1, "unknown field `rendr`"),
         // 4. Unknown key in [render].
         (with("[render]\nwdith = 4"), 2, "unknown field `wdith`"),
         // 5. Mistyped field: a string for a number.
-        (
-            with("[render]\nwidth = \"wide\""),
-            2,
-            "invalid type: string \"wide\"",
-        ),
+        (with("[render]\nwidth = \"wide\""), 2, "invalid type: string \"wide\""),
         // 6. Zero-size image.
-        (
-            with("[render]\nwidth = 0"),
-            2,
-            "render.width must be an integer ≥ 1, got 0",
-        ),
+        (with("[render]\nwidth = 0"), 2, "render.width must be an integer ≥ 1, got 0"),
         // 7. Negative spp.
-        (
-            with("[render]\nspp = -3"),
-            2,
-            "render.spp must be an integer ≥ 1",
-        ),
+        (with("[render]\nspp = -3"), 2, "render.spp must be an integer ≥ 1"),
         // 8. Unknown integrator.
-        (
-            with("[render]\nintegrator = \"magic\""),
-            2,
-            "unknown variant `magic`",
-        ),
+        (with("[render]\nintegrator = \"magic\""), 2, "unknown variant `magic`"),
         // 9. Position with two numbers.
-        (
-            with("[camera]\nposition = [0, 1]"),
-            2,
-            "invalid length 2, expected an array of three numbers",
-        ),
+        (with("[camera]\nposition = [0, 1]"), 2, "invalid length 2, expected an array of three numbers"),
         // 10. Unknown object type.
-        (
-            "[[objects]]\ntype = \"cone\"\nmaterial = \"m\"\n".into(),
-            2,
-            "unknown variant `cone`",
-        ),
+        ("[[objects]]\ntype = \"cone\"\nmaterial = \"m\"\n".into(), 2, "unknown variant `cone`"),
         // 11. Missing radius.
         (
-            format!(
-                "{GOOD_TAIL}\n[[objects]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nmaterial = \"white\"\n"
-            ),
+            format!("{GOOD_TAIL}\n[[objects]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nmaterial = \"white\"\n"),
             16,
             "a sphere needs `radius`",
         ),
@@ -123,24 +89,16 @@ fn cases() -> Vec<(String, usize, &'static str)> {
             "`normal` does not belong to a sphere",
         ),
         // 16. Unknown light type.
-        (
-            format!("{GOOD_TAIL}\n[[lights]]\ntype = \"laser\"\n"),
-            17,
-            "unknown variant `laser`",
-        ),
+        (format!("{GOOD_TAIL}\n[[lights]]\ntype = \"laser\"\n"), 17, "unknown variant `laser`"),
         // 17. Spot without a direction.
         (
-            format!(
-                "{GOOD_TAIL}\n[[lights]]\ntype = \"spot\"\nposition = [0, 3, 0]\nintensity = 5\n"
-            ),
+            format!("{GOOD_TAIL}\n[[lights]]\ntype = \"spot\"\nposition = [0, 3, 0]\nintensity = 5\n"),
             16,
             "a spot needs `direction` or `look_at`",
         ),
         // 18. Negative intensity.
         (
-            format!(
-                "{GOOD_TAIL}\n[[lights]]\ntype = \"point\"\nposition = [0, 3, 0]\nintensity = -5\n"
-            ),
+            format!("{GOOD_TAIL}\n[[lights]]\ntype = \"point\"\nposition = [0, 3, 0]\nintensity = -5\n"),
             19,
             "intensity must be finite and ≥ 0",
         ),
@@ -169,41 +127,17 @@ fn cases() -> Vec<(String, usize, &'static str)> {
             "min must be less than max on every axis",
         ),
         // 22. Medium with g out of range.
-        (
-            with("[medium]\nsigma_s = 0.1\ng = 1.5"),
-            3,
-            "medium.g must lie strictly between -1 and 1, got 1.5",
-        ),
+        (with("[medium]\nsigma_s = 0.1\ng = 1.5"), 3, "medium.g must lie strictly between -1 and 1, got 1.5"),
         // 23. Height fields on a homogeneous medium.
-        (
-            with("[medium]\nsigma_s = 0.1\nfalloff = 2"),
-            3,
-            "base and falloff belong to a `height` medium",
-        ),
+        (with("[medium]\nsigma_s = 0.1\nfalloff = 2"), 3, "base and falloff belong to a `height` medium"),
         // 24. Negative scattering coefficient.
-        (
-            with("[medium]\nsigma_s = [0.1, -0.2, 0.1]"),
-            2,
-            "medium.sigma_s must be finite and ≥ 0",
-        ),
+        (with("[medium]\nsigma_s = [0.1, -0.2, 0.1]"), 2, "medium.sigma_s must be finite and ≥ 0"),
         // 25. Unknown material type.
-        (
-            "[materials.m]\ntype = \"glass\"\n".into(),
-            2,
-            "unknown variant `glass`",
-        ),
+        ("[materials.m]\ntype = \"glass\"\n".into(), 2, "unknown variant `glass`"),
         // 26. Checker field on a diffuse material.
-        (
-            "[materials.m]\nalbedo2 = 0.3\n".into(),
-            2,
-            "materials.m.albedo2 belongs to a checker material",
-        ),
+        ("[materials.m]\nalbedo2 = 0.3\n".into(), 2, "materials.m.albedo2 belongs to a checker material"),
         // 27. Perspective camera with a view_height.
-        (
-            with("[camera]\nview_height = 3"),
-            2,
-            "view_height is for orthographic cameras",
-        ),
+        (with("[camera]\nview_height = 3"), 2, "view_height is for orthographic cameras"),
         // 28. Camera looking at itself.
         (
             with("[camera]\nposition = [1, 1, 1]\nlook_at = [1, 1, 1]"),
@@ -220,17 +154,13 @@ fn cases() -> Vec<(String, usize, &'static str)> {
         ),
         // 30. Object without a material.
         (
-            format!(
-                "{GOOD_TAIL}\n[[objects]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\n"
-            ),
+            format!("{GOOD_TAIL}\n[[objects]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\n"),
             16,
             "needs a `material`",
         ),
         // 31. Mesh file that does not exist.
         (
-            format!(
-                "{GOOD_TAIL}\n[[objects]]\ntype = \"mesh\"\nfile = \"no/such/file.obj\"\nmaterial = \"white\"\n"
-            ),
+            format!("{GOOD_TAIL}\n[[objects]]\ntype = \"mesh\"\nfile = \"no/such/file.obj\"\nmaterial = \"white\"\n"),
             18,
             "cannot load mesh `no/such/file.obj`",
         ),
@@ -262,13 +192,8 @@ fn malformed_mesh_is_rejected_with_the_reason() {
     let dir = tempfile::tempdir().unwrap();
     std::fs::write(dir.path().join("bad.obj"), "v 0 0 0\nv 1 0 0\nf 1 2 7\n").unwrap();
     std::fs::write(dir.path().join("empty.obj"), "# nothing\n").unwrap();
-    for (file, phrase) in [
-        ("bad.obj", "cannot load mesh"),
-        ("empty.obj", "cannot load mesh"),
-    ] {
-        let text = format!(
-            "{GOOD_TAIL}\n[[objects]]\ntype = \"mesh\"\nfile = \"{file}\"\nmaterial = \"white\"\n"
-        );
+    for (file, phrase) in [("bad.obj", "cannot load mesh"), ("empty.obj", "cannot load mesh")] {
+        let text = format!("{GOOD_TAIL}\n[[objects]]\ntype = \"mesh\"\nfile = \"{file}\"\nmaterial = \"white\"\n");
         let e = from_toml_str(&text, Some(dir.path())).unwrap_err();
         assert!(e.message.contains(phrase), "{file}: {}", e.message);
         assert_eq!(e.location.map(|l| l.0), Some(18));
@@ -282,15 +207,9 @@ fn errors_display_file_line_and_column() {
     std::fs::write(&path, "[render]\nwidth = 0\n").unwrap();
     let e = airlight::scene::load(&path).unwrap_err();
     let shown = e.to_string();
-    assert!(
-        shown.starts_with(&format!("{}:2:9: ", path.display())),
-        "{shown}"
-    );
+    assert!(shown.starts_with(&format!("{}:2:9: ", path.display())), "{shown}");
     let missing = airlight::scene::load(&dir.path().join("nope.toml")).unwrap_err();
-    assert!(
-        missing.to_string().contains("cannot read the scene file"),
-        "{missing}"
-    );
+    assert!(missing.to_string().contains("cannot read the scene file"), "{missing}");
 }
 
 #[test]
@@ -302,14 +221,7 @@ fn garbage_never_panics() {
             let _ = from_toml_str(&text[..cut], None);
         }
     }
-    for odd in [
-        "\u{0}",
-        "[[objects]]\n",
-        "[[lights]]\ntype = 3",
-        "render = 5",
-        "[materials]\nx = 1",
-        "🙂 = 1",
-    ] {
+    for odd in ["\u{0}", "[[objects]]\n", "[[lights]]\ntype = 3", "render = 5", "[materials]\nx = 1", "🙂 = 1"] {
         assert!(from_toml_str(odd, None).is_err(), "{odd:?}");
     }
 }

@@ -15,14 +15,9 @@ fn every_example_scene_renders() {
         let mut scene = airlight::scene::load(&path).unwrap_or_else(|e| panic!("{e}"));
         let s = &mut scene.settings;
         (s.width, s.height, s.spp, s.steps) = (40, 30, 1, 16);
-        let image = try_render(&scene, &RenderObserver::none())
-            .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        let image = try_render(&scene, &RenderObserver::none()).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
         let mean = image.mean();
-        assert!(
-            mean.is_finite() && mean.max_element() > 0.0,
-            "{}: mean {mean}",
-            path.display()
-        );
+        assert!(mean.is_finite() && mean.max_element() > 0.0, "{}: mean {mean}", path.display());
         count += 1;
     }
     assert!(count >= 7, "only {count} scenes");

@@ -3,9 +3,7 @@
 //! tested one by one.
 
 use super::Ray;
-use super::shape::{
-    Shape, box_normal, intersect_box, intersect_quad, intersect_sphere, intersect_triangle,
-};
+use super::shape::{Shape, box_normal, intersect_box, intersect_quad, intersect_sphere, intersect_triangle};
 use glam::{Affine3A, Mat3, Vec3, Vec3A};
 use obvhs::{Boundable, BvhBuildParams, aabb::Aabb, cwbvh::CwBvh};
 use std::time::Duration;
@@ -64,11 +62,7 @@ impl Prim {
     fn intersect(&self, o: Vec3, d: Vec3, tmin: f32, tmax: f32) -> f32 {
         match self {
             Prim::Sphere { center, radius } => intersect_sphere(*center, *radius, o, d, tmin, tmax),
-            Prim::Quad {
-                corner,
-                edge_u,
-                edge_v,
-            } => intersect_quad(*corner, *edge_u, *edge_v, o, d, tmin, tmax),
+            Prim::Quad { corner, edge_u, edge_v } => intersect_quad(*corner, *edge_u, *edge_v, o, d, tmin, tmax),
             Prim::Box { min, max } => intersect_box(*min, *max, o, d, tmin, tmax),
             Prim::Triangle { v0, e1, e2 } => intersect_triangle(*v0, *e1, *e2, o, d, tmin, tmax),
             Prim::Instance(inst) => {
@@ -95,24 +89,17 @@ impl Prim {
 
     fn bounds(&self) -> Aabb {
         match self {
-            Prim::Sphere { center, radius } => Aabb::new(
-                Vec3A::from(*center - *radius),
-                Vec3A::from(*center + *radius),
-            ),
-            Prim::Quad {
-                corner,
-                edge_u,
-                edge_v,
-            } => Aabb::from_points(&[
+            Prim::Sphere { center, radius } => {
+                Aabb::new(Vec3A::from(*center - *radius), Vec3A::from(*center + *radius))
+            }
+            Prim::Quad { corner, edge_u, edge_v } => Aabb::from_points(&[
                 (*corner).into(),
                 (*corner + *edge_u).into(),
                 (*corner + *edge_v).into(),
                 (*corner + *edge_u + *edge_v).into(),
             ]),
             Prim::Box { min, max } => Aabb::new((*min).into(), (*max).into()),
-            Prim::Triangle { v0, e1, e2 } => {
-                Aabb::from_points(&[(*v0).into(), (*v0 + *e1).into(), (*v0 + *e2).into()])
-            }
+            Prim::Triangle { v0, e1, e2 } => Aabb::from_points(&[(*v0).into(), (*v0 + *e1).into(), (*v0 + *e2).into()]),
             Prim::Instance(inst) => inst.bounds,
         }
     }
@@ -173,10 +160,7 @@ const LINEAR_LIMIT: usize = 8;
 
 impl std::fmt::Debug for Geometry {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("Geometry")
-            .field("primitives", &self.records.len())
-            .field("planes", &self.planes.len())
-            .finish()
+        f.debug_struct("Geometry").field("primitives", &self.records.len()).field("planes", &self.planes.len()).finish()
     }
 }
 
@@ -191,57 +175,23 @@ impl GeometryBuilder {
     /// Adds a shape with a material index and, for area lights, the index of
     /// the light it is the surface of.
     pub fn add(&mut self, shape: &Shape, material: u32, emitter: Option<u32>) {
-        let mut push = |prim| {
-            self.records.push(Record {
-                prim,
-                material,
-                emitter,
-            })
-        };
+        let mut push = |prim| self.records.push(Record { prim, material, emitter });
         match shape {
-            Shape::Sphere { center, radius } => push(Prim::Sphere {
-                center: *center,
-                radius: *radius,
-            }),
-            Shape::Quad {
-                corner,
-                edge_u,
-                edge_v,
-            } => push(Prim::Quad {
-                corner: *corner,
-                edge_u: *edge_u,
-                edge_v: *edge_v,
-            }),
-            Shape::Box { min, max } => push(Prim::Box {
-                min: *min,
-                max: *max,
-            }),
-            Shape::Mesh {
-                positions,
-                triangles,
-            } => {
+            Shape::Sphere { center, radius } => push(Prim::Sphere { center: *center, radius: *radius }),
+            Shape::Quad { corner, edge_u, edge_v } => {
+                push(Prim::Quad { corner: *corner, edge_u: *edge_u, edge_v: *edge_v })
+            }
+            Shape::Box { min, max } => push(Prim::Box { min: *min, max: *max }),
+            Shape::Mesh { positions, triangles } => {
                 for tri in triangles {
                     let [a, b, c] = tri.map(|i| positions[i as usize]);
-                    push(Prim::Triangle {
-                        v0: a,
-                        e1: b - a,
-                        e2: c - a,
-                    });
+                    push(Prim::Triangle { v0: a, e1: b - a, e2: c - a });
                 }
             }
-            Shape::Transformed {
-                shape,
-                world_from_local,
-            } => {
+            Shape::Transformed { shape, world_from_local } => {
                 let prim = match shape.as_ref() {
-                    Shape::Sphere { center, radius } => Prim::Sphere {
-                        center: *center,
-                        radius: *radius,
-                    },
-                    Shape::Box { min, max } => Prim::Box {
-                        min: *min,
-                        max: *max,
-                    },
+                    Shape::Sphere { center, radius } => Prim::Sphere { center: *center, radius: *radius },
+                    Shape::Box { min, max } => Prim::Box { min: *min, max: *max },
                     // Other shapes are baked by Shape::transformed.
                     other => {
                         let baked = other.clone().transformed(*world_from_local);
@@ -266,50 +216,28 @@ impl GeometryBuilder {
                     bounds,
                 })))
             }
-            Shape::Plane { point, normal } => self.planes.push(PlaneRecord {
-                point: *point,
-                normal: *normal,
-                material,
-            }),
+            Shape::Plane { point, normal } => {
+                self.planes.push(PlaneRecord { point: *point, normal: *normal, material })
+            }
         }
     }
 
     /// Builds the BVH and lays the primitives out in its order.
     pub fn build(self) -> Geometry {
         let GeometryBuilder { records, planes } = self;
-        let bounds = records
-            .iter()
-            .map(|r| r.prim.bounds())
-            .reduce(|a, b| a.union(&b));
+        let bounds = records.iter().map(|r| r.prim.bounds()).reduce(|a, b| a.union(&b));
         let bounds = bounds.map(|b| (Vec3::from(b.min), Vec3::from(b.max)));
         if records.len() <= LINEAR_LIMIT {
-            return Geometry {
-                records,
-                planes,
-                bvh: None,
-                bounds,
-            };
+            return Geometry { records, planes, bvh: None, bounds };
         }
-        let mut bvh = obvhs::cwbvh::builder::build_cwbvh(
-            &records,
-            BvhBuildParams::medium_build(),
-            &mut Duration::default(),
-        );
+        let mut bvh =
+            obvhs::cwbvh::builder::build_cwbvh(&records, BvhBuildParams::medium_build(), &mut Duration::default());
         // Reorder so that the BVH's primitive ids index `records` directly.
-        let ordered: Vec<Record> = bvh
-            .primitive_indices
-            .iter()
-            .map(|&i| records[i as usize].clone())
-            .collect();
+        let ordered: Vec<Record> = bvh.primitive_indices.iter().map(|&i| records[i as usize].clone()).collect();
         for (i, index) in bvh.primitive_indices.iter_mut().enumerate() {
             *index = i as u32;
         }
-        Geometry {
-            records: ordered,
-            planes,
-            bvh: Some(bvh),
-            bounds,
-        }
+        Geometry { records: ordered, planes, bvh: Some(bvh), bounds }
     }
 }
 
@@ -326,23 +254,15 @@ impl Geometry {
 
     /// The nearest hit with 0 < t < tmax.
     pub fn intersect(&self, ray: &Ray, tmax: f32) -> Option<Hit> {
-        let mut best = Hit {
-            t: tmax,
-            id: u32::MAX,
-        };
+        let mut best = Hit { t: tmax, id: u32::MAX };
         match &self.bvh {
             Some(bvh) => {
                 let r = bvh_ray(ray.origin, ray.dir, tmax);
                 let mut hit = obvhs::ray::RayHit::none();
                 if bvh.ray_traverse(r, &mut hit, |r, id| {
-                    self.records[id]
-                        .prim
-                        .intersect(ray.origin, ray.dir, 0.0, r.tmax)
+                    self.records[id].prim.intersect(ray.origin, ray.dir, 0.0, r.tmax)
                 }) {
-                    best = Hit {
-                        t: hit.t,
-                        id: hit.primitive_id,
-                    };
+                    best = Hit { t: hit.t, id: hit.primitive_id };
                 }
             }
             None => {
@@ -358,10 +278,7 @@ impl Geometry {
         for (i, plane) in self.planes.iter().enumerate() {
             let t = intersect_plane(plane, ray.origin, ray.dir);
             if t > 0.0 && t < best.t {
-                best = Hit {
-                    t,
-                    id: base + i as u32,
-                };
+                best = Hit { t, id: base + i as u32 };
             }
         }
         (best.id != u32::MAX).then_some(best)
@@ -379,24 +296,16 @@ impl Geometry {
         match &self.bvh {
             Some(bvh) => {
                 let r = bvh_ray(origin, dir, tmax);
-                !bvh.ray_traverse_miss(r, |r, id| {
-                    self.records[id].prim.intersect(origin, dir, 0.0, r.tmax)
-                })
+                !bvh.ray_traverse_miss(r, |r, id| self.records[id].prim.intersect(origin, dir, 0.0, r.tmax))
             }
-            None => self
-                .records
-                .iter()
-                .any(|rec| rec.prim.intersect(origin, dir, 0.0, tmax) < tmax),
+            None => self.records.iter().any(|rec| rec.prim.intersect(origin, dir, 0.0, tmax) < tmax),
         }
     }
 
     /// The nearest hit found by testing every primitive: the oracle that the
     /// BVH is tested against.
     pub fn intersect_brute_force(&self, ray: &Ray, tmax: f32) -> Option<Hit> {
-        let mut best = Hit {
-            t: tmax,
-            id: u32::MAX,
-        };
+        let mut best = Hit { t: tmax, id: u32::MAX };
         for (i, rec) in self.records.iter().enumerate() {
             let t = rec.prim.intersect(ray.origin, ray.dir, 0.0, best.t);
             if t < best.t {
@@ -407,10 +316,7 @@ impl Geometry {
         for (i, plane) in self.planes.iter().enumerate() {
             let t = intersect_plane(plane, ray.origin, ray.dir);
             if t > 0.0 && t < best.t {
-                best = Hit {
-                    t,
-                    id: base + i as u32,
-                };
+                best = Hit { t, id: base + i as u32 };
             }
         }
         (best.id != u32::MAX).then_some(best)
@@ -421,20 +327,10 @@ impl Geometry {
         let p = ray.at(hit.t);
         let index = hit.id as usize;
         match self.records.get(index) {
-            Some(rec) => SurfaceHit {
-                p,
-                n: rec.prim.normal(p),
-                material: rec.material,
-                emitter: rec.emitter,
-            },
+            Some(rec) => SurfaceHit { p, n: rec.prim.normal(p), material: rec.material, emitter: rec.emitter },
             None => {
                 let plane = &self.planes[index - self.records.len()];
-                SurfaceHit {
-                    p,
-                    n: plane.normal,
-                    material: plane.material,
-                    emitter: None,
-                }
+                SurfaceHit { p, n: plane.normal, material: plane.material, emitter: None }
             }
         }
     }

@@ -48,23 +48,13 @@ impl Shape {
         Shape::Sphere { center, radius }
     }
     pub fn plane(point: Vec3, normal: Vec3) -> Self {
-        Shape::Plane {
-            point,
-            normal: normal.normalize(),
-        }
+        Shape::Plane { point, normal: normal.normalize() }
     }
     pub fn quad(corner: Vec3, edge_u: Vec3, edge_v: Vec3) -> Self {
-        Shape::Quad {
-            corner,
-            edge_u,
-            edge_v,
-        }
+        Shape::Quad { corner, edge_u, edge_v }
     }
     pub fn cuboid(min: Vec3, max: Vec3) -> Self {
-        Shape::Box {
-            min: min.min(max),
-            max: min.max(max),
-        }
+        Shape::Box { min: min.min(max), max: min.max(max) }
     }
 
     /// The shape under `world_from_local`. Planes, quads and meshes are mapped
@@ -79,55 +69,32 @@ impl Shape {
         match self {
             Shape::Plane { point, normal } => {
                 let n = linear.inverse().transpose() * normal;
-                Shape::Plane {
-                    point: m.transform_point3(point),
-                    normal: n.normalize(),
-                }
+                Shape::Plane { point: m.transform_point3(point), normal: n.normalize() }
             }
-            Shape::Quad {
-                corner,
-                edge_u,
-                edge_v,
-            } => Shape::Quad {
-                corner: m.transform_point3(corner),
-                edge_u: linear * edge_u,
-                edge_v: linear * edge_v,
-            },
-            Shape::Mesh {
-                positions,
-                triangles,
-            } => Shape::Mesh {
-                positions: positions.iter().map(|&p| m.transform_point3(p)).collect(),
-                triangles,
-            },
-            Shape::Sphere { center, radius } if is_similarity(linear) => Shape::Sphere {
-                center: m.transform_point3(center),
-                radius: radius * linear.x_axis.length(),
-            },
+            Shape::Quad { corner, edge_u, edge_v } => {
+                Shape::Quad { corner: m.transform_point3(corner), edge_u: linear * edge_u, edge_v: linear * edge_v }
+            }
+            Shape::Mesh { positions, triangles } => {
+                Shape::Mesh { positions: positions.iter().map(|&p| m.transform_point3(p)).collect(), triangles }
+            }
+            Shape::Sphere { center, radius } if is_similarity(linear) => {
+                Shape::Sphere { center: m.transform_point3(center), radius: radius * linear.x_axis.length() }
+            }
             Shape::Box { min, max } if is_diagonal(linear) => {
                 let a = m.transform_point3(min);
                 let b = m.transform_point3(max);
                 Shape::cuboid(a, b)
             }
-            Shape::Transformed {
-                shape,
-                world_from_local,
-            } => Shape::Transformed {
-                shape,
-                world_from_local: m * world_from_local,
-            },
-            other => Shape::Transformed {
-                shape: std::boxed::Box::new(other),
-                world_from_local: m,
-            },
+            Shape::Transformed { shape, world_from_local } => {
+                Shape::Transformed { shape, world_from_local: m * world_from_local }
+            }
+            other => Shape::Transformed { shape: std::boxed::Box::new(other), world_from_local: m },
         }
     }
 }
 
 fn is_diagonal(m: Mat3) -> bool {
-    let off = [
-        m.x_axis.y, m.x_axis.z, m.y_axis.x, m.y_axis.z, m.z_axis.x, m.z_axis.y,
-    ];
+    let off = [m.x_axis.y, m.x_axis.z, m.y_axis.x, m.y_axis.z, m.z_axis.x, m.z_axis.y];
     off.iter().all(|v| v.abs() < 1e-6)
 }
 
@@ -176,15 +143,7 @@ pub fn intersect_sphere(center: Vec3, radius: f32, o: Vec3, d: Vec3, tmin: f32, 
 /// corner = α·edge_u + β·edge_v` with α = ((p−c)×v)·n/|n|², β = (u×(p−c))·n/|n|²
 /// where n = u×v; inside when both lie in [0, 1].
 #[inline]
-pub fn intersect_quad(
-    corner: Vec3,
-    edge_u: Vec3,
-    edge_v: Vec3,
-    o: Vec3,
-    d: Vec3,
-    tmin: f32,
-    tmax: f32,
-) -> f32 {
+pub fn intersect_quad(corner: Vec3, edge_u: Vec3, edge_v: Vec3, o: Vec3, d: Vec3, tmin: f32, tmax: f32) -> f32 {
     let n = edge_u.cross(edge_v);
     let denom = n.dot(d);
     if denom.abs() < 1e-20 {
@@ -198,11 +157,7 @@ pub fn intersect_quad(
     let inv_nn = 1.0 / n.length_squared();
     let alpha = rel.cross(edge_v).dot(n) * inv_nn;
     let beta = edge_u.cross(rel).dot(n) * inv_nn;
-    if (0.0..=1.0).contains(&alpha) && (0.0..=1.0).contains(&beta) {
-        t
-    } else {
-        f32::INFINITY
-    }
+    if (0.0..=1.0).contains(&alpha) && (0.0..=1.0).contains(&beta) { t } else { f32::INFINITY }
 }
 
 /// Ray–box intersection by slabs (Kay and Kajiya 1986). A ray starting inside
@@ -229,15 +184,7 @@ pub fn intersect_box(min: Vec3, max: Vec3, o: Vec3, d: Vec3, tmin: f32, tmax: f3
 /// Ray–triangle intersection of Möller and Trumbore (1997), with the triangle
 /// given as `v0` and its edges `e1 = v1 − v0`, `e2 = v2 − v0`.
 #[inline]
-pub fn intersect_triangle(
-    v0: Vec3,
-    e1: Vec3,
-    e2: Vec3,
-    o: Vec3,
-    d: Vec3,
-    tmin: f32,
-    tmax: f32,
-) -> f32 {
+pub fn intersect_triangle(v0: Vec3, e1: Vec3, e2: Vec3, o: Vec3, d: Vec3, tmin: f32, tmax: f32) -> f32 {
     let pvec = d.cross(e2);
     let det = e1.dot(pvec);
     if det.abs() < 1e-20 {
@@ -255,11 +202,7 @@ pub fn intersect_triangle(
         return f32::INFINITY;
     }
     let t = e2.dot(qvec) * inv_det;
-    if t > tmin && t < tmax {
-        t
-    } else {
-        f32::INFINITY
-    }
+    if t > tmin && t < tmax { t } else { f32::INFINITY }
 }
 
 /// The outward normal of an axis-aligned box at a point on its surface: the

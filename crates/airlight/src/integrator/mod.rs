@@ -10,7 +10,7 @@ pub use raymarch::Raymarch;
 use crate::Rgb;
 use crate::geometry::{Ray, SurfaceHit, offset_origin};
 use crate::medium::Medium;
-use crate::sampling::Sampler;
+use crate::sampling::{Sampler, keyed2};
 use crate::scene::Scene;
 use serde::Deserialize;
 
@@ -64,16 +64,10 @@ impl IntegratorKind {
 impl std::str::FromStr for IntegratorKind {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {
-        IntegratorKind::ALL
-            .into_iter()
-            .find(|k| k.name() == s)
-            .ok_or_else(|| {
-                let names: Vec<&str> = IntegratorKind::ALL.iter().map(|k| k.name()).collect();
-                format!(
-                    "unknown integrator `{s}`; expected one of {}",
-                    names.join(", ")
-                )
-            })
+        IntegratorKind::ALL.into_iter().find(|k| k.name() == s).ok_or_else(|| {
+            let names: Vec<&str> = IntegratorKind::ALL.iter().map(|k| k.name()).collect();
+            format!("unknown integrator `{s}`; expected one of {}", names.join(", "))
+        })
     }
 }
 
@@ -88,13 +82,8 @@ pub fn for_scene(scene: &Scene) -> Result<Box<dyn Integrator>, String> {
     let s = &scene.settings;
     match s.integrator {
         IntegratorKind::Direct => Ok(Box::new(Direct)),
-        IntegratorKind::Raymarch => Ok(Box::new(Raymarch {
-            steps: s.steps,
-            jitter: s.jitter,
-        })),
-        other => Err(format!(
-            "the `{other}` integrator is not implemented yet; available: direct, raymarch"
-        )),
+        IntegratorKind::Raymarch => Ok(Box::new(Raymarch { steps: s.steps, jitter: s.jitter })),
+        other => Err(format!("the `{other}` integrator is not implemented yet; available: direct, raymarch")),
     }
 }
 
@@ -114,32 +103,27 @@ pub(crate) fn surface_radiance(
         None => Rgb::ZERO,
     };
     let material = &scene.materials[surface.material as usize];
-    for light in &scene.lights {
-        let u = sampler.next2();
-        let Some(sample) = light.sample(surface.p, u) else {
-            continue;
-        };
+    let key = sampler.next_key();
+    scene.for_each_light_at(surface.p, |index, light| {
+        let Some(sample) = light.sample(surface.p, keyed2(key, index as u64)) else { return };
         let cos = sample.wi.dot(surface.n).abs();
         if cos == 0.0 || sample.weight == Rgb::ZERO {
-            continue;
+            return;
         }
         let f = material.brdf(surface.p, surface.n, wo, sample.wi);
         if f == Rgb::ZERO {
-            continue;
+            return;
         }
         let origin = offset_origin(surface.p, surface.n, sample.wi);
         let distance = scene.light_distance(sample.distance);
-        if scene
-            .geometry
-            .occluded(origin, sample.wi, distance * (1.0 - 1e-4))
-        {
-            continue;
+        if scene.geometry.occluded(origin, sample.wi, distance * (1.0 - 1e-4)) {
+            return;
         }
         let mut contribution = f * sample.weight * cos;
         if let Some(m) = medium {
             contribution *= m.transmittance(origin, sample.wi, 0.0, distance);
         }
         radiance += contribution;
-    }
+    });
     radiance
 }

@@ -6,7 +6,7 @@ use super::{Integrator, surface_radiance};
 use crate::Rgb;
 use crate::geometry::Ray;
 use crate::medium::Medium;
-use crate::sampling::Sampler;
+use crate::sampling::{Sampler, keyed2};
 use crate::scene::Scene;
 use glam::DVec3;
 
@@ -84,26 +84,18 @@ pub fn in_scattered(
         let tau = medium.optical_depth(ray.origin, ray.dir, a, a + dt);
         let weight = segment_weight(tau, dt);
         let mut light_in = Rgb::ZERO;
-        for light in &scene.lights {
-            let Some(sample) = light.sample(p, sampler.next2()) else {
-                continue;
-            };
+        let key = sampler.next_key();
+        scene.for_each_light_at(p, |index, light| {
+            let Some(sample) = light.sample(p, keyed2(key, index as u64)) else { return };
             let distance = scene.light_distance(sample.distance);
-            if scene
-                .geometry
-                .occluded(p, sample.wi, distance * (1.0 - 1e-4))
-            {
-                continue;
+            if scene.geometry.occluded(p, sample.wi, distance * (1.0 - 1e-4)) {
+                return;
             }
             let phase = medium.phase(wo, sample.wi);
             light_in += sample.weight * phase * medium.transmittance(p, sample.wi, 0.0, distance);
-        }
+        });
         total += to_eye * (medium.sigma_s * medium.density_at(p) * weight * light_in).as_dvec3();
-        to_eye *= DVec3::new(
-            (-tau.x as f64).exp(),
-            (-tau.y as f64).exp(),
-            (-tau.z as f64).exp(),
-        );
+        to_eye *= DVec3::new((-tau.x as f64).exp(), (-tau.y as f64).exp(), (-tau.z as f64).exp());
     }
     total.as_vec3()
 }
@@ -112,11 +104,7 @@ pub fn in_scattered(
 #[inline]
 pub fn segment_weight(tau: Rgb, dt: f32) -> Rgb {
     let w = |x: f32| {
-        if x < 1e-5 {
-            dt * (1.0 - 0.5 * x)
-        } else {
-            dt * -(-x).exp_m1() / x
-        }
+        if x < 1e-5 { dt * (1.0 - 0.5 * x) } else { dt * -(-x).exp_m1() / x }
     };
     Rgb::new(w(tau.x), w(tau.y), w(tau.z))
 }

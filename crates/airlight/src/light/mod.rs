@@ -1,8 +1,13 @@
 //! Lights, in the units of DESIGN.md: point and spot `intensity` in W/sr,
 //! distant `irradiance` on a facing surface, sphere and quad `radiance`.
 
+mod attenuation;
 mod spot;
 
+pub use attenuation::{
+    Attenuation, AttenuationModel, cutoff_falloff, cutoff_range, sphere_falloff, window_rational, window_tan,
+    window_ue4,
+};
 pub use spot::{SpotProfile, spot_falloff};
 
 use crate::Rgb;
@@ -14,6 +19,7 @@ pub enum Light {
     Point {
         position: Vec3,
         intensity: Rgb,
+        attenuation: Attenuation,
     },
     Spot {
         position: Vec3,
@@ -25,6 +31,7 @@ pub enum Light {
         /// Half angle where the falloff begins, radians.
         falloff_start: f32,
         profile: SpotProfile,
+        attenuation: Attenuation,
     },
     /// A sun: parallel light travelling along the unit vector `direction`.
     Distant {
@@ -35,6 +42,7 @@ pub enum Light {
         center: Vec3,
         radius: f32,
         radiance: Rgb,
+        attenuation: Attenuation,
     },
     /// Emits on the side of normalize(edge_u × edge_v) only.
     Quad {
@@ -62,20 +70,11 @@ pub struct LightSample {
 
 impl Light {
     pub fn point(position: Vec3, intensity: Rgb) -> Self {
-        Light::Point {
-            position,
-            intensity,
-        }
+        Light::Point { position, intensity, attenuation: Attenuation::PHYSICAL }
     }
 
     /// A spot light; angles in degrees, profile smoothstep.
-    pub fn spot(
-        position: Vec3,
-        target: Vec3,
-        intensity: Rgb,
-        cone_deg: f32,
-        falloff_start_deg: f32,
-    ) -> Self {
+    pub fn spot(position: Vec3, target: Vec3, intensity: Rgb, cone_deg: f32, falloff_start_deg: f32) -> Self {
         Light::Spot {
             position,
             direction: (target - position).normalize(),
@@ -83,99 +82,92 @@ impl Light {
             cone_angle: cone_deg.to_radians(),
             falloff_start: falloff_start_deg.to_radians(),
             profile: SpotProfile::Smoothstep,
+            attenuation: Attenuation::PHYSICAL,
         }
     }
 
     pub fn distant(direction: Vec3, irradiance: Rgb) -> Self {
-        Light::Distant {
-            direction: direction.normalize(),
-            irradiance,
-        }
+        Light::Distant { direction: direction.normalize(), irradiance }
     }
 
     pub fn sphere(center: Vec3, radius: f32, radiance: Rgb) -> Self {
-        Light::Sphere {
-            center,
-            radius,
-            radiance,
+        let attenuation = Attenuation { radius, ..Attenuation::PHYSICAL };
+        Light::Sphere { center, radius, radiance, attenuation }
+    }
+
+    /// The same light with another falloff (point, spot and sphere lights;
+    /// others are returned unchanged). A sphere light keeps its own radius.
+    pub fn with_attenuation(mut self, a: Attenuation) -> Self {
+        match &mut self {
+            Light::Point { attenuation, .. } | Light::Spot { attenuation, .. } => *attenuation = a,
+            Light::Sphere { attenuation, radius, .. } => *attenuation = Attenuation { radius: *radius, ..a },
+            _ => {}
+        }
+        self
+    }
+
+    /// Where a light with a finite range reaches: its centre and the
+    /// distance from the centre beyond which it gives nothing. None for
+    /// lights that reach everywhere.
+    pub fn reach(&self) -> Option<(Vec3, f32)> {
+        match *self {
+            Light::Point { position: c, attenuation: a, .. }
+            | Light::Spot { position: c, attenuation: a, .. }
+            | Light::Sphere { center: c, attenuation: a, .. }
+                if a.range.is_finite() =>
+            {
+                Some((c, a.radius + a.range))
+            }
+            _ => None,
+        }
+    }
+
+    /// Radiant intensity (W/sr) of a point or spot light, and the
+    /// equivalent π r² L of a sphere light.
+    pub fn intensity(&self) -> Rgb {
+        match *self {
+            Light::Point { intensity, .. } | Light::Spot { intensity, .. } => intensity,
+            Light::Sphere { radius, radiance, .. } => radiance * (std::f32::consts::PI * radius * radius),
+            _ => Rgb::ZERO,
         }
     }
 
     pub fn quad(corner: Vec3, edge_u: Vec3, edge_v: Vec3, radiance: Rgb) -> Self {
-        Light::Quad {
-            corner,
-            edge_u,
-            edge_v,
-            radiance,
-        }
+        Light::Quad { corner, edge_u, edge_v, radiance }
     }
 
     /// Whether the light is a point or direction (no area to hit or sample).
     pub fn is_delta(&self) -> bool {
-        matches!(
-            self,
-            Light::Point { .. } | Light::Spot { .. } | Light::Distant { .. }
-        )
+        matches!(self, Light::Point { .. } | Light::Spot { .. } | Light::Distant { .. })
     }
 
     /// Samples light arriving at `p`; `u` uniform in [0, 1)². None when no light
     /// arrives from the sample (outside a spot's cone, behind a quad light).
     pub fn sample(&self, p: Vec3, u: Vec2) -> Option<LightSample> {
         match *self {
-            Light::Point {
-                position,
-                intensity,
-            } => {
-                let to = position - p;
-                let d2 = to.length_squared();
-                let distance = d2.sqrt();
-                Some(LightSample {
-                    wi: to / distance,
-                    distance,
-                    weight: intensity / d2,
-                    pdf: 0.0,
-                })
+            Light::Point { position, intensity, attenuation } => {
+                let (wi, distance, falloff) = point_falloff(position, p, &attenuation)?;
+                Some(LightSample { wi, distance, weight: intensity * falloff, pdf: 0.0 })
             }
-            Light::Spot {
-                position,
-                direction,
-                intensity,
-                cone_angle,
-                falloff_start,
-                profile,
-            } => {
-                let to = position - p;
-                let d2 = to.length_squared();
-                let distance = d2.sqrt();
-                let wi = to / distance;
-                let falloff = spot_falloff(profile, -wi.dot(direction), cone_angle, falloff_start);
-                (falloff > 0.0).then(|| LightSample {
-                    wi,
-                    distance,
-                    weight: intensity * (falloff / d2),
-                    pdf: 0.0,
-                })
+            Light::Spot { position, direction, intensity, cone_angle, falloff_start, profile, attenuation } => {
+                let (wi, distance, falloff) = point_falloff(position, p, &attenuation)?;
+                let cone = spot_falloff(profile, -wi.dot(direction), cone_angle, falloff_start);
+                (cone > 0.0).then(|| LightSample { wi, distance, weight: intensity * (cone * falloff), pdf: 0.0 })
             }
-            Light::Distant {
-                direction,
-                irradiance,
-            } => Some(LightSample {
-                wi: -direction,
-                distance: f32::INFINITY,
-                weight: irradiance,
-                pdf: 0.0,
-            }),
-            Light::Sphere {
-                center,
-                radius,
-                radiance,
-            } => sample_sphere(center, radius, radiance, p, u),
-            Light::Quad {
-                corner,
-                edge_u,
-                edge_v,
-                radiance,
-            } => {
+            Light::Distant { direction, irradiance } => {
+                Some(LightSample { wi: -direction, distance: f32::INFINITY, weight: irradiance, pdf: 0.0 })
+            }
+            Light::Sphere { center, radius, radiance, attenuation } => match attenuation.model {
+                AttenuationModel::Physical => sample_sphere(center, radius, radiance, p, u),
+                // The approximations treat the sphere as a point at its
+                // centre with intensity π r² L (see attenuation.rs).
+                _ => {
+                    let (wi, distance, falloff) = point_falloff(center, p, &attenuation)?;
+                    let weight = radiance * (std::f32::consts::PI * radius * radius * falloff);
+                    Some(LightSample { wi, distance: (distance - radius).max(0.0), weight, pdf: 0.0 })
+                }
+            },
+            Light::Quad { corner, edge_u, edge_v, radiance } => {
                 let x = corner + edge_u * u.x + edge_v * u.y;
                 let to = x - p;
                 let d2 = to.length_squared();
@@ -188,12 +180,7 @@ impl Light {
                     return None;
                 }
                 let pdf = d2 / (area * cos_light);
-                Some(LightSample {
-                    wi,
-                    distance,
-                    weight: radiance / pdf,
-                    pdf,
-                })
+                Some(LightSample { wi, distance, weight: radiance / pdf, pdf })
             }
         }
     }
@@ -209,17 +196,33 @@ impl Light {
     }
 }
 
+/// Direction and distance from `p` to a point light at `position`, and the
+/// factor that turns its intensity into irradiance on a facing surface:
+/// 1/D² for the physical law, else f(d)/r² with d = D − r (attenuation.rs).
+/// None beyond the light's range.
+#[inline]
+fn point_falloff(position: Vec3, p: Vec3, a: &Attenuation) -> Option<(Vec3, f32, f32)> {
+    let to = position - p;
+    let d2 = to.length_squared();
+    let distance = d2.sqrt();
+    let falloff = match a.model {
+        AttenuationModel::Physical => 1.0 / d2,
+        _ => {
+            let d = distance - a.radius;
+            if !a.reaches(d) {
+                return None;
+            }
+            a.factor(d) / (a.radius * a.radius)
+        }
+    };
+    Some((to / distance, distance, falloff))
+}
+
 /// Samples a sphere light over the cone of directions it subtends from `p`
 /// (pbrt-v4, Sphere::Sample with a reference point): uniform in that cone,
 /// pdf = 1/(2π(1 − cos θmax)). From inside the sphere, directions are uniform
 /// over the whole sphere of directions.
-fn sample_sphere(
-    center: Vec3,
-    radius: f32,
-    radiance: Rgb,
-    p: Vec3,
-    u: Vec2,
-) -> Option<LightSample> {
+fn sample_sphere(center: Vec3, radius: f32, radiance: Rgb, p: Vec3, u: Vec2) -> Option<LightSample> {
     let to_center = center - p;
     let dc2 = to_center.length_squared();
     let r2 = radius * radius;
@@ -242,18 +245,9 @@ fn sample_sphere(
     let along = to_center.dot(wi);
     let closest2 = (dc2 - along * along).max(0.0);
     let half_chord = (r2 - closest2).max(0.0).sqrt();
-    let distance = if dc2 <= r2 {
-        along + half_chord
-    } else {
-        (along - half_chord).max(0.0)
-    };
+    let distance = if dc2 <= r2 { along + half_chord } else { (along - half_chord).max(0.0) };
     let pdf = 1.0 / (2.0 * std::f32::consts::PI * one_minus_cos);
-    Some(LightSample {
-        wi,
-        distance,
-        weight: radiance / pdf,
-        pdf,
-    })
+    Some(LightSample { wi, distance, weight: radiance / pdf, pdf })
 }
 
 #[cfg(test)]

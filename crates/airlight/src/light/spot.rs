@@ -16,12 +16,7 @@ pub enum SpotProfile {
 ///
 /// Smoothstep is pbrt-v4's SpotLight::I: t = (cos θ − cos cone)/(cos start −
 /// cos cone), t²(3 − 2t). Linear is Mitsuba 3's spot: (cone − θ)/(cone − start).
-pub fn spot_falloff(
-    profile: SpotProfile,
-    cos_theta: f32,
-    cone_angle: f32,
-    falloff_start: f32,
-) -> f32 {
+pub fn spot_falloff(profile: SpotProfile, cos_theta: f32, cone_angle: f32, falloff_start: f32) -> f32 {
     let cos_cone = cone_angle.cos();
     if cos_theta < cos_cone {
         return 0.0;

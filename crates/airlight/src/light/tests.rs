@@ -37,22 +37,14 @@ fn quad_light_irradiance_matches_lambert_closed_form() {
     let (eu, ev) = (Vec3::new(2.0, 0.0, 0.0), Vec3::new(0.0, 0.0, 1.0));
     assert!(eu.cross(ev).y < 0.0, "faces down");
     let light = Light::quad(corner, eu, ev, Rgb::splat(3.0));
-    let verts: Vec<glam::DVec3> = [corner, corner + eu, corner + eu + ev, corner + ev]
-        .iter()
-        .map(|v| v.as_dvec3())
-        .collect();
+    let verts: Vec<glam::DVec3> =
+        [corner, corner + eu, corner + eu + ev, corner + ev].iter().map(|v| v.as_dvec3()).collect();
     let exact = polygon_irradiance(&verts, 3.0, glam::DVec3::Y);
     // 1024 samples, as the issue asks.
     let est = estimated_irradiance(&light, Vec3::ZERO, Vec3::Y, 32);
-    assert!(
-        (est / exact - 1.0).abs() < 0.01,
-        "estimate {est} exact {exact}"
-    );
+    assert!((est / exact - 1.0).abs() < 0.01, "estimate {est} exact {exact}");
     // From above, the light's back faces the point: no light.
-    assert_eq!(
-        estimated_irradiance(&light, Vec3::new(0.5, 3.0, 0.1), -Vec3::Y, 4),
-        0.0
-    );
+    assert_eq!(estimated_irradiance(&light, Vec3::new(0.5, 3.0, 0.1), -Vec3::Y, 4), 0.0);
 }
 
 #[test]
@@ -62,10 +54,7 @@ fn sphere_light_irradiance_matches_closed_form() {
         let light = Light::sphere(Vec3::new(0.0, dist, 0.0), radius, Rgb::splat(2.0));
         let exact = PI * 2.0 * (radius as f64 / dist as f64).powi(2);
         let est = estimated_irradiance(&light, Vec3::ZERO, Vec3::Y, 64);
-        assert!(
-            (est / exact - 1.0).abs() < 0.005,
-            "r {radius} D {dist}: {est} vs {exact}"
-        );
+        assert!((est / exact - 1.0).abs() < 0.005, "r {radius} D {dist}: {est} vs {exact}");
     }
 }
 
@@ -96,14 +85,8 @@ fn spot_profiles_match_their_definitions() {
     let (cone, start) = (30f32.to_radians(), 20f32.to_radians());
     for profile in [SpotProfile::Smoothstep, SpotProfile::Linear] {
         assert_eq!(spot_falloff(profile, 1.0, cone, start), 1.0);
-        assert_eq!(
-            spot_falloff(profile, 19f32.to_radians().cos(), cone, start),
-            1.0
-        );
-        assert_eq!(
-            spot_falloff(profile, 31f32.to_radians().cos(), cone, start),
-            0.0
-        );
+        assert_eq!(spot_falloff(profile, 19f32.to_radians().cos(), cone, start), 1.0);
+        assert_eq!(spot_falloff(profile, 31f32.to_radians().cos(), cone, start), 0.0);
     }
     // Linear: half-way in angle gives one half.
     let mid = spot_falloff(SpotProfile::Linear, 25f32.to_radians().cos(), cone, start);
@@ -112,17 +95,52 @@ fn spot_profiles_match_their_definitions() {
     let mid_cos = 0.5 * (cone.cos() + start.cos());
     assert!((spot_falloff(SpotProfile::Smoothstep, mid_cos, cone, start) - 0.5).abs() < 1e-4);
     // Equal angles: a hard edge.
-    assert_eq!(
-        spot_falloff(
-            SpotProfile::Smoothstep,
-            29.9f32.to_radians().cos(),
-            cone,
-            cone
-        ),
-        1.0
-    );
-    assert_eq!(
-        spot_falloff(SpotProfile::Linear, 30.1f32.to_radians().cos(), cone, cone),
-        0.0
-    );
+    assert_eq!(spot_falloff(SpotProfile::Smoothstep, 29.9f32.to_radians().cos(), cone, cone), 1.0);
+    assert_eq!(spot_falloff(SpotProfile::Linear, 30.1f32.to_radians().cos(), cone, cone), 0.0);
+}
+
+#[test]
+fn seed_sphere_attenuation_is_exact_for_a_facing_point() {
+    // The seed's 1/(d/r + 1)² in Airlight's normalisation, E = πL·f(d),
+    // equals the closed form πL(r/D)² on a point facing the sphere, and the
+    // cone-sampled exact light agrees.
+    let (r, l) = (0.4f32, 3.0f32);
+    for dist in [0.5f32, 1.0, 2.5, 9.0] {
+        let center = Vec3::new(0.0, dist, 0.0);
+        let approx = Light::sphere(center, r, Rgb::splat(l))
+            .with_attenuation(Attenuation::new(AttenuationModel::Sphere, r, 0.0, None, None).unwrap());
+        let s = approx.sample(Vec3::ZERO, Vec2::ZERO).unwrap();
+        let seed = std::f64::consts::PI * l as f64 * sphere_falloff(dist - r, r) as f64;
+        let closed = PI * l as f64 * (r as f64 / dist as f64).powi(2);
+        assert!((s.weight.x as f64 / seed - 1.0).abs() < 1e-5);
+        assert!((seed / closed - 1.0).abs() < 1e-5, "d {dist}: {seed} vs {closed}");
+        let exact = estimated_irradiance(&Light::sphere(center, r, Rgb::splat(l)), Vec3::ZERO, Vec3::Y, 64);
+        assert!((exact / closed - 1.0).abs() < 0.005);
+    }
+}
+
+#[test]
+fn sphere_light_cone_sampling_agrees_with_random_area_sampling() {
+    // An independent estimator: uniform points on the sphere's surface,
+    // E = ∫ L cosθ cosθ' / r² dA over the visible cap, at a tilted point.
+    let (c, r, l) = (Vec3::new(0.3, 2.0, -0.4), 0.6f32, 2.0f32);
+    let n = Vec3::new(0.2, 1.0, 0.1).normalize();
+    let mut s = crate::sampling::Sampler::for_pixel(4, 4, 4);
+    let samples = 400_000;
+    let mut area_sum = 0.0f64;
+    for _ in 0..samples {
+        let on = crate::sampling::uniform_sphere(s.next2());
+        let x = c + on * r;
+        let to = x - Vec3::ZERO;
+        let d2 = to.length_squared();
+        let wi = to / d2.sqrt();
+        let cos_surface = wi.dot(n).max(0.0);
+        let cos_light = (-wi).dot(on);
+        if cos_light > 0.0 {
+            area_sum += (l * cos_surface * cos_light / d2) as f64;
+        }
+    }
+    let area_estimate = area_sum / samples as f64 * 4.0 * PI * (r as f64).powi(2);
+    let cone = estimated_irradiance(&Light::sphere(c, r, Rgb::splat(l)), Vec3::ZERO, n, 128);
+    assert!((cone / area_estimate - 1.0).abs() < 0.005, "cone {cone} area {area_estimate}");
 }

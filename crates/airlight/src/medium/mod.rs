@@ -30,21 +30,11 @@ pub enum Density {
 
 impl Medium {
     pub fn homogeneous(sigma_a: Rgb, sigma_s: Rgb, g: f32) -> Self {
-        Medium {
-            sigma_a,
-            sigma_s,
-            g,
-            density: Density::Homogeneous,
-        }
+        Medium { sigma_a, sigma_s, g, density: Density::Homogeneous }
     }
 
     pub fn height(sigma_a: Rgb, sigma_s: Rgb, g: f32, base: f32, falloff: f32) -> Self {
-        Medium {
-            sigma_a,
-            sigma_s,
-            g,
-            density: Density::Height { base, falloff },
-        }
+        Medium { sigma_a, sigma_s, g, density: Density::Height { base, falloff } }
     }
 
     /// Extinction coefficient σt = σa + σs where the density is 1.
@@ -92,11 +82,7 @@ impl Medium {
                     };
                 }
                 let x = a * length;
-                if x.abs() < 1e-8 {
-                    rho0 * length * (1.0 - 0.5 * x)
-                } else {
-                    rho0 * -(-x).exp_m1() / a
-                }
+                if x.abs() < 1e-8 { rho0 * length * (1.0 - 0.5 * x) } else { rho0 * -(-x).exp_m1() / a }
             }
         }
     }
@@ -109,11 +95,7 @@ impl Medium {
         }
         let integral = self.density_integral(o, d, t0, t1);
         // σt = 0 channels stay 0 even over infinite lengths.
-        Rgb::new(
-            scaled(sigma_t.x, integral),
-            scaled(sigma_t.y, integral),
-            scaled(sigma_t.z, integral),
-        )
+        Rgb::new(scaled(sigma_t.x, integral), scaled(sigma_t.y, integral), scaled(sigma_t.z, integral))
     }
 
     /// Transmittance exp(−optical depth) over the segment, per channel.
@@ -131,11 +113,7 @@ impl Medium {
 }
 
 fn scaled(sigma: f32, integral: f64) -> f32 {
-    if sigma == 0.0 {
-        0.0
-    } else {
-        (sigma as f64 * integral) as f32
-    }
+    if sigma == 0.0 { 0.0 } else { (sigma as f64 * integral) as f32 }
 }
 
 #[cfg(test)]

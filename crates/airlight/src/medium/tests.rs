@@ -19,10 +19,7 @@ fn homogeneous_transmittance_is_beer_lambert() {
     assert_eq!(t.y, 1.0);
     assert!((t.z as f64 / numeric(0.4) - 1.0).abs() < 1e-6);
     // A channel with σt = 0 transmits everything even over an infinite length.
-    assert_eq!(
-        m.transmittance(Vec3::ZERO, Vec3::X, 0.0, f32::INFINITY).y,
-        1.0
-    );
+    assert_eq!(m.transmittance(Vec3::ZERO, Vec3::X, 0.0, f32::INFINITY).y, 1.0);
 }
 
 #[test]
@@ -41,10 +38,7 @@ fn height_fog_optical_depth_matches_numeric_integral() {
         let density = |t: f64| (-0.7 * (o.y as f64 + t * d.y as f64 - 0.5)).exp();
         let numeric = 0.25 * simpson(density, t0 as f64, t1 as f64, 20_000);
         let closed = m.optical_depth(o, d, t0, t1).x as f64;
-        assert!(
-            (closed / numeric - 1.0).abs() < 1e-6,
-            "d {d}: {closed} vs {numeric}"
-        );
+        assert!((closed / numeric - 1.0).abs() < 1e-6, "d {d}: {closed} vs {numeric}");
     }
 }
 
@@ -57,25 +51,15 @@ fn height_fog_to_infinity_upward_converges() {
     let expected = (-2.0f64).exp() / 1.6;
     let depth = m.optical_depth(o, d, 0.0, f32::INFINITY).x as f64;
     assert!((depth / expected - 1.0).abs() < 1e-6);
-    assert_eq!(
-        m.transmittance(o, -d, 0.0, f32::INFINITY).x,
-        0.0,
-        "downward it never ends"
-    );
+    assert_eq!(m.transmittance(o, -d, 0.0, f32::INFINITY).x, 0.0, "downward it never ends");
 }
 
 #[test]
 fn henyey_greenstein_integrates_to_one_and_g_is_forward() {
     for g in [-0.9f32, -0.5, 0.0, 0.3, 0.8, 0.95] {
         // ∫ p dω = 2π ∫_{-1}^{1} p(μ) dμ; dense Simpson for the peaked g.
-        let total = 2.0
-            * std::f64::consts::PI
-            * simpson(
-                |mu| henyey_greenstein(mu as f32, g) as f64,
-                -1.0,
-                1.0,
-                200_000,
-            );
+        let total =
+            2.0 * std::f64::consts::PI * simpson(|mu| henyey_greenstein(mu as f32, g) as f64, -1.0, 1.0, 200_000);
         assert!((total - 1.0).abs() < 1e-4, "g {g}: {total}");
     }
     // Forward: light continuing straight on, wi = −wo, cos θ = −1.

@@ -7,7 +7,7 @@ use crate::Rgb;
 use crate::camera::{Camera, Projection};
 use crate::geometry::Shape;
 use crate::integrator::IntegratorKind;
-use crate::light::{Light, SpotProfile};
+use crate::light::{Attenuation, Light, SpotProfile};
 use crate::material::Material;
 use crate::medium::Medium;
 use glam::{Affine3A, Quat, Vec3};
@@ -108,16 +108,10 @@ impl Checker<'_> {
         let count = |v: &Option<Spanned<i64>>, name: &str, min: i64, default: u32| -> Result<u32> {
             match v {
                 None => Ok(default),
-                Some(v) if *v.get_ref() >= min && *v.get_ref() <= u32::MAX as i64 => {
-                    Ok(*v.get_ref() as u32)
+                Some(v) if *v.get_ref() >= min && *v.get_ref() <= u32::MAX as i64 => Ok(*v.get_ref() as u32),
+                Some(v) => {
+                    Err(self.err(v.span(), format!("render.{name} must be an integer ≥ {min}, got {}", v.get_ref())))
                 }
-                Some(v) => Err(self.err(
-                    v.span(),
-                    format!(
-                        "render.{name} must be an integer ≥ {min}, got {}",
-                        v.get_ref()
-                    ),
-                )),
             }
         };
         s.width = count(&r.width, "width", 1, s.width)?;
@@ -146,6 +140,9 @@ impl Checker<'_> {
         if let Some(j) = r.jitter {
             s.jitter = j;
         }
+        if let Some(c) = r.cull_lights {
+            s.cull_lights = c;
+        }
         Ok(s)
     }
 
@@ -153,11 +150,7 @@ impl Checker<'_> {
         if v.is_finite() {
             Ok(v)
         } else {
-            Err(self.err_field(
-                span,
-                what,
-                format!("{what} must be a finite number, got {v}"),
-            ))
+            Err(self.err_field(span, what, format!("{what} must be a finite number, got {v}")))
         }
     }
 
@@ -165,11 +158,7 @@ impl Checker<'_> {
         if v.is_finite() && v > 0.0 {
             Ok(v)
         } else {
-            Err(self.err_field(
-                span,
-                what,
-                format!("{what} must be a positive finite number, got {v}"),
-            ))
+            Err(self.err_field(span, what, format!("{what} must be a positive finite number, got {v}")))
         }
     }
 
@@ -177,31 +166,19 @@ impl Checker<'_> {
         if v.is_finite() && v >= 0.0 {
             Ok(v)
         } else {
-            Err(self.err_field(
-                span,
-                what,
-                format!("{what} must be a finite number ≥ 0, got {v}"),
-            ))
+            Err(self.err_field(span, what, format!("{what} must be a finite number ≥ 0, got {v}")))
         }
     }
 
     fn finite3(&self, span: Range<usize>, what: &str, v: Vec3) -> Result<Vec3> {
-        if v.is_finite() {
-            Ok(v)
-        } else {
-            Err(self.err_field(span, what, format!("{what} must be finite, got {v}")))
-        }
+        if v.is_finite() { Ok(v) } else { Err(self.err_field(span, what, format!("{what} must be finite, got {v}"))) }
     }
 
     fn non_negative3(&self, span: Range<usize>, what: &str, v: Vec3) -> Result<Vec3> {
         if v.is_finite() && v.min_element() >= 0.0 {
             Ok(v)
         } else {
-            Err(self.err_field(
-                span,
-                what,
-                format!("{what} must be finite and ≥ 0, got {v}"),
-            ))
+            Err(self.err_field(span, what, format!("{what} must be finite and ≥ 0, got {v}")))
         }
     }
 
@@ -218,11 +195,7 @@ impl Checker<'_> {
         let span = desc.span();
         let c = desc.get_ref();
         let point = |v: Option<Point>, name: &str, default: Vec3| -> Result<Vec3> {
-            self.finite3(
-                span.clone(),
-                &format!("camera.{name}"),
-                v.map_or(default, |p| p.0),
-            )
+            self.finite3(span.clone(), &format!("camera.{name}"), v.map_or(default, |p| p.0))
         };
         let default = default_camera();
         let look_at = point(c.look_at, "look_at", Vec3::new(0.0, 1.0, 0.0))?;
@@ -230,64 +203,52 @@ impl Checker<'_> {
         let position = match c.kind {
             CameraType::Isometric => {
                 if c.position.is_some() {
-                    return Err(self.err(
-                        span,
-                        "an isometric camera is placed by look_at and distance, not position",
-                    ));
+                    return Err(self.err(span, "an isometric camera is placed by look_at and distance, not position"));
                 }
-                let distance =
-                    self.positive(span.clone(), "camera.distance", c.distance.unwrap_or(50.0))?;
+                let distance = self.positive(span.clone(), "camera.distance", c.distance.unwrap_or(50.0))?;
                 look_at - crate::camera::ISOMETRIC_VIEW * distance
             }
             _ => point(c.position, "position", default.position)?,
         };
         let forward = look_at - position;
         if forward.length_squared() == 0.0 {
-            return Err(self.err_field(
-                span,
-                "look_at",
-                "camera.position and camera.look_at must differ",
-            ));
+            return Err(self.err_field(span, "look_at", "camera.position and camera.look_at must differ"));
         }
         if forward.normalize().cross(up.normalize()).length() < 1e-6 {
             return Err(self.err(span, "camera.up must not be parallel to the view direction"));
         }
-        let projection =
-            match c.kind {
-                CameraType::Perspective => {
-                    if c.view_height.is_some() {
-                        return Err(self.err_field(
-                        span, "view_height",
+        let projection = match c.kind {
+            CameraType::Perspective => {
+                if c.view_height.is_some() {
+                    return Err(self.err_field(
+                        span,
+                        "view_height",
                         "view_height is for orthographic cameras; a perspective camera takes fov",
                     ));
-                    }
-                    let fov = c.fov.unwrap_or(40.0);
-                    if !(fov > 0.0 && fov < 180.0) {
-                        return Err(self.err_field(
-                            span,
-                            "fov",
-                            format!("camera.fov must be between 0 and 180 degrees, got {fov}"),
-                        ));
-                    }
-                    Projection::Perspective { fov_degrees: fov }
                 }
-                CameraType::Orthographic | CameraType::Isometric => {
-                    if c.fov.is_some() {
-                        return Err(self.err_field(
-                        span, "fov",
+                let fov = c.fov.unwrap_or(40.0);
+                if !(fov > 0.0 && fov < 180.0) {
+                    return Err(self.err_field(
+                        span,
+                        "fov",
+                        format!("camera.fov must be between 0 and 180 degrees, got {fov}"),
+                    ));
+                }
+                Projection::Perspective { fov_degrees: fov }
+            }
+            CameraType::Orthographic | CameraType::Isometric => {
+                if c.fov.is_some() {
+                    return Err(self.err_field(
+                        span,
+                        "fov",
                         "fov is for perspective cameras; an orthographic camera takes view_height",
                     ));
-                    }
-                    let h = self.positive(
-                        span.clone(),
-                        "camera.view_height",
-                        c.view_height.unwrap_or(10.0),
-                    )?;
-                    Projection::Orthographic { view_height: h }
                 }
-            };
-        let aperture =
-            self.non_negative(span.clone(), "camera.aperture", c.aperture.unwrap_or(0.0))?;
+                let h = self.positive(span.clone(), "camera.view_height", c.view_height.unwrap_or(10.0))?;
+                Projection::Orthographic { view_height: h }
+            }
+        };
+        let aperture = self.non_negative(span.clone(), "camera.aperture", c.aperture.unwrap_or(0.0))?;
         let focus = c.focus_distance.unwrap_or(forward.length());
         let focus = self.positive(span, "camera.focus_distance", focus)?;
         Ok(Camera::oriented(position, look_at, up, projection).with_lens(aperture, focus))
@@ -296,23 +257,11 @@ impl Checker<'_> {
     fn medium(&self, desc: &Spanned<MediumDesc>) -> Result<Medium> {
         let span = desc.span();
         let m = desc.get_ref();
-        let sigma_a = self.non_negative3(
-            span.clone(),
-            "medium.sigma_a",
-            m.sigma_a.map_or(Vec3::ZERO, |t| t.0),
-        )?;
-        let sigma_s = self.non_negative3(
-            span.clone(),
-            "medium.sigma_s",
-            m.sigma_s.map_or(Vec3::ZERO, |t| t.0),
-        )?;
+        let sigma_a = self.non_negative3(span.clone(), "medium.sigma_a", m.sigma_a.map_or(Vec3::ZERO, |t| t.0))?;
+        let sigma_s = self.non_negative3(span.clone(), "medium.sigma_s", m.sigma_s.map_or(Vec3::ZERO, |t| t.0))?;
         let g = m.g.unwrap_or(0.0);
         if !(g > -1.0 && g < 1.0) {
-            return Err(self.err_field(
-                span,
-                "g",
-                format!("medium.g must lie strictly between -1 and 1, got {g}"),
-            ));
+            return Err(self.err_field(span, "g", format!("medium.g must lie strictly between -1 and 1, got {g}")));
         }
         match m.kind {
             MediumType::Homogeneous => {
@@ -327,8 +276,7 @@ impl Checker<'_> {
             }
             MediumType::Height => {
                 let base = self.finite(span.clone(), "medium.base", m.base.unwrap_or(0.0))?;
-                let falloff =
-                    self.non_negative(span, "medium.falloff", m.falloff.unwrap_or(0.5))?;
+                let falloff = self.non_negative(span, "medium.falloff", m.falloff.unwrap_or(0.5))?;
                 Ok(Medium::height(sigma_a, sigma_s, g, base, falloff))
             }
         }
@@ -339,19 +287,11 @@ impl Checker<'_> {
         let m = desc.get_ref();
         let what = |field: &str| format!("materials.{name}.{field}");
         let albedo = |t: Option<Triple>, field: &str, default: f32| -> Result<Rgb> {
-            self.non_negative3(
-                span.clone(),
-                &what(field),
-                t.map_or(Vec3::splat(default), |t| t.0),
-            )
+            self.non_negative3(span.clone(), &what(field), t.map_or(Vec3::splat(default), |t| t.0))
         };
         let misplaced = |present: bool, field: &str, owner: &str| -> Result<()> {
             if present {
-                Err(self.err_field(
-                    span.clone(),
-                    field,
-                    format!("{} belongs to a {owner} material", what(field)),
-                ))
+                Err(self.err_field(span.clone(), field, format!("{} belongs to a {owner} material", what(field))))
             } else {
                 Ok(())
             }
@@ -374,19 +314,13 @@ impl Checker<'_> {
             }
             MaterialType::Phong => {
                 let specular = albedo(m.specular, "specular", 0.04)?;
-                let exponent =
-                    self.non_negative(span, &what("exponent"), m.exponent.unwrap_or(32.0))?;
+                let exponent = self.non_negative(span, &what("exponent"), m.exponent.unwrap_or(32.0))?;
                 Material::phong(a, specular, exponent)
             }
         })
     }
 
-    fn object(
-        &self,
-        index: usize,
-        desc: &Spanned<ObjectDesc>,
-        scene: &SceneDesc,
-    ) -> Result<(Shape, String)> {
+    fn object(&self, index: usize, desc: &Spanned<ObjectDesc>, scene: &SceneDesc) -> Result<(Shape, String)> {
         let span = desc.span();
         let o = desc.get_ref();
         let kind = format!("{:?}", o.kind).to_lowercase();
@@ -410,22 +344,15 @@ impl Checker<'_> {
             ObjectType::Box => &["min", "max"],
             ObjectType::Mesh => &["file"],
         };
-        self.check_fields(span.clone(), &label, &kind, &fields, takes)?;
-        let get = |p: Option<Point>, name: &str| {
-            self.finite3(span.clone(), &format!("{label}.{name}"), p.unwrap().0)
-        };
+        self.check_fields(span.clone(), &label, &kind, &fields, takes, &[])?;
+        let get = |p: Option<Point>, name: &str| self.finite3(span.clone(), &format!("{label}.{name}"), p.unwrap().0);
         let shape = match o.kind {
             ObjectType::Sphere => {
-                let radius =
-                    self.positive(span.clone(), &format!("{label}.radius"), o.radius.unwrap())?;
+                let radius = self.positive(span.clone(), &format!("{label}.radius"), o.radius.unwrap())?;
                 Shape::sphere(get(o.center, "center")?, radius)
             }
             ObjectType::Plane => {
-                let normal = self.nonzero3(
-                    span.clone(),
-                    &format!("{label}.normal"),
-                    o.normal.unwrap().0,
-                )?;
+                let normal = self.nonzero3(span.clone(), &format!("{label}.normal"), o.normal.unwrap().0)?;
                 Shape::plane(get(o.point, "point")?, normal)
             }
             ObjectType::Quad => {
@@ -442,7 +369,11 @@ impl Checker<'_> {
             ObjectType::Box => {
                 let (min, max) = (get(o.min, "min")?, get(o.max, "max")?);
                 if !min.cmplt(max).all() {
-                    return Err(self.err_field(span, "max", format!("{label}: min must be less than max on every axis, got min {min} max {max}")));
+                    return Err(self.err_field(
+                        span,
+                        "max",
+                        format!("{label}: min must be less than max on every axis, got min {min} max {max}"),
+                    ));
                 }
                 Shape::cuboid(min, max)
             }
@@ -455,20 +386,13 @@ impl Checker<'_> {
                     let known: Vec<&str> = scene.materials.keys().map(String::as_str).collect();
                     return Err(self.err(
                         name.span(),
-                        format!(
-                            "{label}: unknown material `{}`; the scene defines: {}",
-                            name.get_ref(),
-                            list(&known)
-                        ),
+                        format!("{label}: unknown material `{}`; the scene defines: {}", name.get_ref(), list(&known)),
                     ));
                 }
                 name.get_ref().clone()
             }
             None => {
-                return Err(self.err(
-                    span,
-                    format!("{label} needs a `material` (a name from [materials])"),
-                ));
+                return Err(self.err(span, format!("{label} needs a `material` (a name from [materials])")));
             }
         };
         Ok((shape.transformed(transform), material))
@@ -482,21 +406,20 @@ impl Checker<'_> {
         label: &str,
         kind: &str,
         fields: &[(&str, bool)],
-        takes: &[&str],
+        required: &[&str],
+        optional: &[&str],
     ) -> Result<()> {
         for (name, present) in fields {
-            if *present && !takes.contains(name) {
+            if *present && !required.contains(name) && !optional.contains(name) {
+                let takes = [required, optional].concat();
                 return Err(self.err_field(
                     span,
                     name,
-                    format!(
-                        "{label}: `{name}` does not belong to a {kind}, which takes {}",
-                        list(takes)
-                    ),
+                    format!("{label}: `{name}` does not belong to a {kind}, which takes {}", list(&takes)),
                 ));
             }
         }
-        for name in takes {
+        for name in required {
             if !fields.iter().any(|(n, present)| n == name && *present) {
                 return Err(self.err(span, format!("{label}: a {kind} needs `{name}`")));
             }
@@ -506,21 +429,10 @@ impl Checker<'_> {
 
     /// T·Rz·Ry·Rx·S: scale, then rotate about X, Y, Z (degrees), then translate.
     fn transform(&self, span: Range<usize>, label: &str, o: &ObjectDesc) -> Result<Affine3A> {
-        let translate = self.finite3(
-            span.clone(),
-            &format!("{label}.translate"),
-            o.translate.map_or(Vec3::ZERO, |p| p.0),
-        )?;
-        let rotate = self.finite3(
-            span.clone(),
-            &format!("{label}.rotate"),
-            o.rotate.map_or(Vec3::ZERO, |p| p.0),
-        )?;
-        let scale = self.finite3(
-            span.clone(),
-            &format!("{label}.scale"),
-            o.scale.map_or(Vec3::ONE, |p| p.0),
-        )?;
+        let translate =
+            self.finite3(span.clone(), &format!("{label}.translate"), o.translate.map_or(Vec3::ZERO, |p| p.0))?;
+        let rotate = self.finite3(span.clone(), &format!("{label}.rotate"), o.rotate.map_or(Vec3::ZERO, |p| p.0))?;
+        let scale = self.finite3(span.clone(), &format!("{label}.scale"), o.scale.map_or(Vec3::ONE, |p| p.0))?;
         if scale.cmpeq(Vec3::ZERO).any() {
             return Err(self.err_field(
                 span,
@@ -529,11 +441,8 @@ impl Checker<'_> {
             ));
         }
         let r = rotate * (std::f32::consts::PI / 180.0);
-        let rotation =
-            Quat::from_rotation_z(r.z) * Quat::from_rotation_y(r.y) * Quat::from_rotation_x(r.x);
-        Ok(Affine3A::from_scale_rotation_translation(
-            scale, rotation, translate,
-        ))
+        let rotation = Quat::from_rotation_z(r.z) * Quat::from_rotation_y(r.y) * Quat::from_rotation_x(r.x);
+        Ok(Affine3A::from_scale_rotation_translation(scale, rotation, translate))
     }
 
     fn mesh(&self, label: &str, file: &Spanned<String>) -> Result<Shape> {
@@ -541,17 +450,9 @@ impl Checker<'_> {
             Some(dir) => dir.join(file.get_ref()),
             None => file.get_ref().into(),
         };
-        let fail = |why: String| {
-            self.err(
-                file.span(),
-                format!("{label}: cannot load mesh `{}`: {why}", path.display()),
-            )
-        };
-        let options = tobj::LoadOptions {
-            triangulate: true,
-            single_index: true,
-            ..Default::default()
-        };
+        let fail =
+            |why: String| self.err(file.span(), format!("{label}: cannot load mesh `{}`: {why}", path.display()));
+        let options = tobj::LoadOptions { triangulate: true, single_index: true, ..Default::default() };
         let (models, _) = tobj::load_obj(&path, &options).map_err(|e| fail(e.to_string()))?;
         let mut positions = Vec::new();
         let mut triangles = Vec::new();
@@ -568,10 +469,7 @@ impl Checker<'_> {
             let count = m.positions.len() / 3;
             for t in m.indices.chunks_exact(3) {
                 if t.iter().any(|&i| i as usize >= count) {
-                    return Err(fail(format!(
-                        "a face refers to vertex {} of {count}",
-                        t.iter().max().unwrap() + 1
-                    )));
+                    return Err(fail(format!("a face refers to vertex {} of {count}", t.iter().max().unwrap() + 1)));
                 }
                 triangles.push([base + t[0], base + t[1], base + t[2]]);
             }
@@ -579,10 +477,7 @@ impl Checker<'_> {
         if triangles.is_empty() {
             return Err(fail("it holds no faces".into()));
         }
-        Ok(Shape::Mesh {
-            positions,
-            triangles,
-        })
+        Ok(Shape::Mesh { positions, triangles })
     }
 
     fn light(&self, index: usize, desc: &Spanned<LightDesc>) -> Result<Light> {
@@ -590,7 +485,7 @@ impl Checker<'_> {
         let l = desc.get_ref();
         let kind = format!("{:?}", l.kind).to_lowercase();
         let label = format!("lights[{index}] ({kind})");
-        let fields: [(&str, bool); 14] = [
+        let fields: [(&str, bool); 17] = [
             ("position", l.position.is_some()),
             ("intensity", l.intensity.is_some()),
             ("direction", l.direction.is_some()),
@@ -605,70 +500,36 @@ impl Checker<'_> {
             ("corner", l.corner.is_some()),
             ("edge_u", l.edge_u.is_some()),
             ("edge_v", l.edge_v.is_some()),
+            ("attenuation", l.attenuation.is_some()),
+            ("cutoff", l.cutoff.is_some()),
+            ("range", l.range.is_some()),
         ];
         let at = |name: &str| format!("{label}.{name}");
-        let point =
-            |p: Option<Point>, name: &str| self.finite3(span.clone(), &at(name), p.unwrap().0);
-        let power = |t: Option<Triple>, name: &str| {
-            self.non_negative3(span.clone(), &at(name), t.unwrap().0)
+        let point = |p: Option<Point>, name: &str| self.finite3(span.clone(), &at(name), p.unwrap().0);
+        let power = |t: Option<Triple>, name: &str| self.non_negative3(span.clone(), &at(name), t.unwrap().0);
+        let check = |required: &[&str], optional: &[&str]| {
+            self.check_fields(span.clone(), &label, &kind, &fields, required, optional)
         };
-        match l.kind {
+        const FALLOFF: [&str; 3] = ["attenuation", "cutoff", "range"];
+        let light = match l.kind {
             LightType::Point => {
-                self.check_fields(
-                    span.clone(),
-                    &label,
-                    &kind,
-                    &fields,
-                    &["position", "intensity"],
-                )?;
-                Ok(Light::point(
-                    point(l.position, "position")?,
-                    power(l.intensity, "intensity")?,
-                ))
+                check(&["position", "intensity"], &[&FALLOFF[..], &["radius"]].concat())?;
+                Light::point(point(l.position, "position")?, power(l.intensity, "intensity")?)
             }
             LightType::Spot => {
-                // A spot takes a direction or a look_at, and optional angles.
-                let optional = [
-                    "cone_angle",
-                    "falloff_start",
-                    "profile",
-                    "direction",
-                    "look_at",
-                ];
-                let given: Vec<(&str, bool)> = fields
-                    .iter()
-                    .copied()
-                    .filter(|(n, _)| !optional.contains(n))
-                    .collect();
-                self.check_fields(
-                    span.clone(),
-                    &label,
-                    &kind,
-                    &given,
-                    &["position", "intensity"],
-                )?;
+                let optional = ["cone_angle", "falloff_start", "profile", "direction", "look_at", "radius"];
+                check(&["position", "intensity"], &[&FALLOFF[..], &optional].concat())?;
                 let position = point(l.position, "position")?;
                 let direction = match (l.direction, l.look_at) {
                     (Some(d), None) => self.nonzero3(span.clone(), &at("direction"), d.0)?,
                     (None, Some(t)) => self
                         .nonzero3(span.clone(), &at("look_at"), t.0 - position)
-                        .map_err(|_| {
-                            self.err(
-                                span.clone(),
-                                format!("{label}: look_at must differ from position"),
-                            )
-                        })?,
+                        .map_err(|_| self.err(span.clone(), format!("{label}: look_at must differ from position")))?,
                     (Some(_), Some(_)) => {
-                        return Err(self.err(
-                            span,
-                            format!("{label}: give direction or look_at, not both"),
-                        ));
+                        return Err(self.err(span, format!("{label}: give direction or look_at, not both")));
                     }
                     (None, None) => {
-                        return Err(self.err(
-                            span,
-                            format!("{label}: a spot needs `direction` or `look_at`"),
-                        ));
+                        return Err(self.err(span, format!("{label}: a spot needs `direction` or `look_at`")));
                     }
                 };
                 let cone = l.cone_angle.unwrap_or(30.0);
@@ -681,51 +542,34 @@ impl Checker<'_> {
                 }
                 let start = l.falloff_start.unwrap_or(cone);
                 if !(start >= 0.0 && start <= cone) {
-                    return Err(self.err_field(span, "falloff_start", format!("{label}.falloff_start must be in [0, cone_angle = {cone}] degrees, got {start}")));
+                    return Err(self.err_field(
+                        span,
+                        "falloff_start",
+                        format!("{label}.falloff_start must be in [0, cone_angle = {cone}] degrees, got {start}"),
+                    ));
                 }
-                Ok(Light::Spot {
+                Light::Spot {
                     position,
                     direction: direction.normalize(),
                     intensity: power(l.intensity, "intensity")?,
                     cone_angle: cone.to_radians(),
                     falloff_start: start.to_radians(),
                     profile: l.profile.map_or(SpotProfile::Smoothstep, Into::into),
-                })
+                    attenuation: Attenuation::PHYSICAL,
+                }
             }
             LightType::Distant => {
-                self.check_fields(
-                    span.clone(),
-                    &label,
-                    &kind,
-                    &fields,
-                    &["direction", "irradiance"],
-                )?;
+                check(&["direction", "irradiance"], &[])?;
                 let d = self.nonzero3(span.clone(), &at("direction"), l.direction.unwrap().0)?;
-                Ok(Light::distant(d, power(l.irradiance, "irradiance")?))
+                return Ok(Light::distant(d, power(l.irradiance, "irradiance")?));
             }
             LightType::Sphere => {
-                self.check_fields(
-                    span.clone(),
-                    &label,
-                    &kind,
-                    &fields,
-                    &["center", "radius", "radiance"],
-                )?;
+                check(&["center", "radius", "radiance"], &FALLOFF)?;
                 let radius = self.positive(span.clone(), &at("radius"), l.radius.unwrap())?;
-                Ok(Light::sphere(
-                    point(l.center, "center")?,
-                    radius,
-                    power(l.radiance, "radiance")?,
-                ))
+                Light::sphere(point(l.center, "center")?, radius, power(l.radiance, "radiance")?)
             }
             LightType::Quad => {
-                self.check_fields(
-                    span.clone(),
-                    &label,
-                    &kind,
-                    &fields,
-                    &["corner", "edge_u", "edge_v", "radiance"],
-                )?;
+                check(&["corner", "edge_u", "edge_v", "radiance"], &[])?;
                 let (u, v) = (point(l.edge_u, "edge_u")?, point(l.edge_v, "edge_v")?);
                 if u.cross(v).length_squared() == 0.0 {
                     return Err(self.err_field(
@@ -734,14 +578,22 @@ impl Checker<'_> {
                         format!("{label}: edge_u and edge_v must not be parallel or zero"),
                     ));
                 }
-                Ok(Light::quad(
-                    point(l.corner, "corner")?,
-                    u,
-                    v,
-                    power(l.radiance, "radiance")?,
-                ))
+                return Ok(Light::quad(point(l.corner, "corner")?, u, v, power(l.radiance, "radiance")?));
             }
-        }
+        };
+        // The falloff of a point, spot or sphere light.
+        let radius = match l.radius {
+            Some(r) => self.positive(span.clone(), &at("radius"), r)?,
+            None => Attenuation::PHYSICAL.radius,
+        };
+        let cutoff = l.cutoff.map(|c| self.positive(span.clone(), &at("cutoff"), c)).transpose()?;
+        let range = l.range.map(|r| self.positive(span.clone(), &at("range"), r)).transpose()?;
+        let model = l.attenuation.unwrap_or_default();
+        // E₀, the irradiance at the light's surface, in its brightest channel.
+        let e0 = light.intensity().max_element() / (radius * radius);
+        let attenuation = Attenuation::new(model, radius, e0, cutoff, range)
+            .map_err(|why| self.err_field(span.clone(), "attenuation", format!("{label}: {why}")))?;
+        Ok(light.with_attenuation(attenuation))
     }
 }
 
@@ -749,9 +601,5 @@ fn list(names: &[&str]) -> String {
     if names.is_empty() {
         return "(none)".into();
     }
-    names
-        .iter()
-        .map(|n| format!("`{n}`"))
-        .collect::<Vec<_>>()
-        .join(", ")
+    names.iter().map(|n| format!("`{n}`")).collect::<Vec<_>>().join(", ")
 }

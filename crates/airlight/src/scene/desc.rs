@@ -3,7 +3,7 @@
 //! and turns them into a [`Scene`](super::Scene).
 
 use crate::integrator::IntegratorKind;
-use crate::light::SpotProfile;
+use crate::light::{AttenuationModel, SpotProfile};
 use crate::scene::Tonemap;
 use glam::Vec3;
 use serde::Deserialize;
@@ -43,6 +43,7 @@ pub struct RenderDesc {
     pub exposure: Option<Spanned<f32>>,
     pub tonemap: Option<Tonemap>,
     pub jitter: Option<bool>,
+    pub cull_lights: Option<bool>,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
@@ -184,6 +185,12 @@ pub struct LightDesc {
     pub corner: Option<Point>,
     pub edge_u: Option<Point>,
     pub edge_v: Option<Point>,
+    /// Point, spot and sphere lights: how light falls off with distance.
+    pub attenuation: Option<AttenuationModel>,
+    /// Irradiance below which a finite-range falloff drops the light.
+    pub cutoff: Option<f32>,
+    /// d_max: how far from its surface a finite-range falloff reaches.
+    pub range: Option<f32>,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
@@ -245,9 +252,7 @@ impl<'de> Visitor<'de> for TripleVisitor {
     fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<Vec3, A::Error> {
         let mut v = [0.0f32; 3];
         for (i, slot) in v.iter_mut().enumerate() {
-            *slot = seq
-                .next_element::<f32>()?
-                .ok_or_else(|| de::Error::invalid_length(i, &self))?;
+            *slot = seq.next_element::<f32>()?.ok_or_else(|| de::Error::invalid_length(i, &self))?;
         }
         if seq.next_element::<de::IgnoredAny>()?.is_some() {
             return Err(de::Error::invalid_length(4, &self));
@@ -258,16 +263,12 @@ impl<'de> Visitor<'de> for TripleVisitor {
 
 impl<'de> Deserialize<'de> for Point {
     fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
-        d.deserialize_any(TripleVisitor {
-            allow_scalar: false,
-        })
-        .map(Point)
+        d.deserialize_any(TripleVisitor { allow_scalar: false }).map(Point)
     }
 }
 
 impl<'de> Deserialize<'de> for Triple {
     fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
-        d.deserialize_any(TripleVisitor { allow_scalar: true })
-            .map(Triple)
+        d.deserialize_any(TripleVisitor { allow_scalar: true }).map(Triple)
     }
 }

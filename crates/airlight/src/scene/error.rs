@@ -13,20 +13,12 @@ pub struct SceneError {
 
 impl SceneError {
     pub fn new(message: impl Into<String>) -> Self {
-        SceneError {
-            file: None,
-            location: None,
-            message: message.into(),
-        }
+        SceneError { file: None, location: None, message: message.into() }
     }
 
     /// The error at byte offset `offset` of `text`.
     pub fn at(text: &str, offset: usize, message: impl Into<String>) -> Self {
-        SceneError {
-            file: None,
-            location: Some(line_col(text, offset)),
-            message: message.into(),
-        }
+        SceneError { file: None, location: Some(line_col(text, offset)), message: message.into() }
     }
 
     pub fn in_file(mut self, file: impl Into<PathBuf>) -> Self {

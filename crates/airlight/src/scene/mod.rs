@@ -4,10 +4,12 @@
 mod build;
 mod desc;
 mod error;
+mod lights;
 
 pub use build::{from_toml_str, load};
 pub use desc::SceneDesc;
 pub use error::{SceneError, line_col};
+pub use lights::LightCulling;
 
 use crate::Rgb;
 use crate::camera::Camera;
@@ -52,6 +54,8 @@ pub struct RenderSettings {
     pub tonemap: Tonemap,
     /// Offset march samples by a random fraction of a step per pixel sample.
     pub jitter: bool,
+    /// Skip lights whose range ends before a point (finite-range falloffs).
+    pub cull_lights: bool,
 }
 
 impl Default for RenderSettings {
@@ -69,6 +73,7 @@ impl Default for RenderSettings {
             exposure: 0.0,
             tonemap: Tonemap::Clamp,
             jitter: true,
+            cull_lights: true,
         }
     }
 }
@@ -87,17 +92,40 @@ pub struct Scene {
     /// pbrt-v4 and Mitsuba 3.
     pub bounds_center: Vec3,
     pub bounds_radius: f32,
+    pub light_culling: LightCulling,
 }
 
 impl Scene {
     /// The distance a shadow ray toward a light sample should span: the
     /// sample's distance, or for a sun, across the scene's bounding sphere.
     pub fn light_distance(&self, distance: f32) -> f32 {
-        if distance.is_finite() {
-            distance
-        } else {
-            2.0 * self.bounds_radius
+        if distance.is_finite() { distance } else { 2.0 * self.bounds_radius }
+    }
+
+    /// Calls `f(index, light)` for every light that may reach `p`, in index
+    /// order: with culling, lights whose range ends before `p` are skipped
+    /// without being looked at.
+    pub fn for_each_light_at(&self, p: Vec3, mut f: impl FnMut(usize, &Light)) {
+        if !self.settings.cull_lights || !self.light_culling.has_ranges() {
+            for (i, light) in self.lights.iter().enumerate() {
+                f(i, light);
+            }
+            return;
         }
+        thread_local! {
+            static FOUND: std::cell::RefCell<Vec<u32>> = const { std::cell::RefCell::new(Vec::new()) };
+        }
+        let mut visit = |found: &mut Vec<u32>| {
+            self.light_culling.lights_at(p, found);
+            for &i in found.iter() {
+                f(i as usize, &self.lights[i as usize]);
+            }
+        };
+        // A reused buffer, or a fresh one if a caller nests these loops.
+        FOUND.with(|found| match found.try_borrow_mut() {
+            Ok(mut found) => visit(&mut found),
+            Err(_) => visit(&mut Vec::new()),
+        });
     }
 }
 
@@ -145,8 +173,7 @@ impl SceneBuilder {
         match self.material_names.get(name) {
             Some(&i) => self.materials[i as usize] = material,
             None => {
-                self.material_names
-                    .insert(name.to_string(), self.materials.len() as u32);
+                self.material_names.insert(name.to_string(), self.materials.len() as u32);
                 self.materials.push(material);
             }
         }
@@ -174,15 +201,7 @@ impl SceneBuilder {
 
     /// Checks and builds the scene, with its BVH.
     pub fn build(self) -> Result<Scene, SceneError> {
-        let SceneBuilder {
-            settings,
-            camera,
-            mut materials,
-            material_names,
-            objects,
-            lights,
-            medium,
-        } = self;
+        let SceneBuilder { settings, camera, mut materials, material_names, objects, lights, medium } = self;
         if settings.width == 0 || settings.height == 0 {
             return Err(SceneError::new(format!(
                 "image size must be at least 1×1, got {}×{}",
@@ -210,39 +229,21 @@ impl SceneBuilder {
         for (i, light) in lights.iter().enumerate() {
             let shape = match *light {
                 Light::Sphere { center, radius, .. } => Shape::sphere(center, radius),
-                Light::Quad {
-                    corner,
-                    edge_u,
-                    edge_v,
-                    ..
-                } => Shape::quad(corner, edge_u, edge_v),
+                Light::Quad { corner, edge_u, edge_v, .. } => Shape::quad(corner, edge_u, edge_v),
                 _ => continue,
             };
             geometry.add(&shape, black, Some(i as u32));
         }
         let geometry = geometry.build();
         let (bounds_center, bounds_radius) = bounding_sphere(&geometry, &lights, &camera);
-        Ok(Scene {
-            settings,
-            camera,
-            materials,
-            lights,
-            medium,
-            geometry,
-            bounds_center,
-            bounds_radius,
-        })
+        let light_culling = LightCulling::new(&lights);
+        Ok(Scene { settings, camera, materials, lights, medium, geometry, bounds_center, bounds_radius, light_culling })
     }
 }
 
 /// The camera of a scene that names none: DESIGN.md's example camera.
 pub fn default_camera() -> Camera {
-    Camera::look_at(
-        Vec3::new(0.0, 2.0, -6.0),
-        Vec3::new(0.0, 1.0, 0.0),
-        Vec3::Y,
-        40.0,
-    )
+    Camera::look_at(Vec3::new(0.0, 2.0, -6.0), Vec3::new(0.0, 1.0, 0.0), Vec3::Y, 40.0)
 }
 
 fn bounding_sphere(geometry: &Geometry, lights: &[Light], camera: &Camera) -> (Vec3, f32) {
@@ -263,18 +264,8 @@ fn bounding_sphere(geometry: &Geometry, lights: &[Light], camera: &Camera) -> (V
                 grow(center - radius);
                 grow(center + radius);
             }
-            Light::Quad {
-                corner,
-                edge_u,
-                edge_v,
-                ..
-            } => {
-                for p in [
-                    corner,
-                    corner + edge_u,
-                    corner + edge_v,
-                    corner + edge_u + edge_v,
-                ] {
+            Light::Quad { corner, edge_u, edge_v, .. } => {
+                for p in [corner, corner + edge_u, corner + edge_v, corner + edge_u + edge_v] {
                     grow(p);
                 }
             }

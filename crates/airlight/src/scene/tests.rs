@@ -54,33 +54,12 @@ fn file_and_builder_make_the_same_scene() {
     let built = SceneBuilder::new()
         .size(24, 16)
         .with_settings(|s| s.spp = 2)
-        .camera(Camera::look_at(
-            vec3(0.0, 2.0, -6.0),
-            vec3(0.0, 1.0, 0.0),
-            Vec3::Y,
-            40.0,
-        ))
-        .material(
-            "floor",
-            Material::checker(Rgb::splat(0.8), Rgb::splat(0.2), 1.0),
-        )
-        .material(
-            "ball",
-            Material::phong(Rgb::new(0.2, 0.4, 0.9), Rgb::splat(0.1), 20.0),
-        )
+        .camera(Camera::look_at(vec3(0.0, 2.0, -6.0), vec3(0.0, 1.0, 0.0), Vec3::Y, 40.0))
+        .material("floor", Material::checker(Rgb::splat(0.8), Rgb::splat(0.2), 1.0))
+        .material("ball", Material::phong(Rgb::new(0.2, 0.4, 0.9), Rgb::splat(0.1), 20.0))
         .object(Shape::plane(Vec3::ZERO, Vec3::Y), "floor")
-        .object_transformed(
-            Shape::sphere(Vec3::ZERO, 1.0),
-            Affine3A::from_translation(Vec3::Y),
-            "ball",
-        )
-        .light(Light::spot(
-            vec3(0.0, 5.0, 0.0),
-            Vec3::ZERO,
-            Rgb::splat(40.0),
-            30.0,
-            25.0,
-        ))
+        .object_transformed(Shape::sphere(Vec3::ZERO, 1.0), Affine3A::from_translation(Vec3::Y), "ball")
+        .light(Light::spot(vec3(0.0, 5.0, 0.0), Vec3::ZERO, Rgb::splat(40.0), 30.0, 25.0))
         .build()
         .unwrap();
     assert_eq!(from_file.settings, built.settings);
@@ -93,15 +72,8 @@ fn file_and_builder_make_the_same_scene() {
 
 #[test]
 fn builder_rejects_unknown_materials_and_empty_images() {
-    let unknown = SceneBuilder::new()
-        .object(Shape::sphere(Vec3::ZERO, 1.0), "nope")
-        .build();
-    assert!(
-        unknown
-            .unwrap_err()
-            .message
-            .contains("unknown material `nope`")
-    );
+    let unknown = SceneBuilder::new().object(Shape::sphere(Vec3::ZERO, 1.0), "nope").build();
+    assert!(unknown.unwrap_err().message.contains("unknown material `nope`"));
     let empty = SceneBuilder::new().size(0, 10).build();
     assert!(empty.unwrap_err().message.contains("at least 1×1"));
 }
@@ -110,8 +82,5 @@ fn builder_rejects_unknown_materials_and_empty_images() {
 fn fog_without_an_integrator_named_is_ray_marched() {
     let scene = from_toml_str("[medium]\nsigma_s = 0.1\n", None).unwrap();
     assert_eq!(scene.settings.integrator, IntegratorKind::Raymarch);
-    assert_eq!(
-        from_toml_str("", None).unwrap().settings.integrator,
-        IntegratorKind::Direct
-    );
+    assert_eq!(from_toml_str("", None).unwrap().settings.integrator, IntegratorKind::Direct);
 }
