@@ -10,6 +10,8 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
 
+mod plot;
+
 /// The built-in demo scene: spheres on a checker floor under a spot light in fog.
 const DEMO_SCENE: &str = include_str!("../../../scenes/demo.toml");
 
@@ -26,6 +28,9 @@ enum Command {
     Render(RenderArgs),
     /// Check a scene file and print what it holds.
     Info { scene: PathBuf },
+    /// Plot the attenuation curves of a light of given radius, intensity and
+    /// cutoff as a PNG, and print where each reaches zero (d_max).
+    Attenuation(AttenuationArgs),
     /// Compare two EXR images: prints rmse, rel_mse, mae and max.
     Compare {
         image: PathBuf,
@@ -59,6 +64,10 @@ struct RenderArgs {
     height: Option<u32>,
     #[arg(long)]
     seed: Option<u64>,
+    /// Falloff for every point, spot and sphere light: physical, sphere,
+    /// cutoff, window_tan, window_rational, window_ue4 (each keeps its cutoff).
+    #[arg(long, value_parser = parse_attenuation)]
+    attenuation: Option<airlight::light::AttenuationModel>,
     /// Worker threads (default: all cores). The image does not depend on it.
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
     threads: Option<u32>,
@@ -67,12 +76,32 @@ struct RenderArgs {
     quiet: bool,
 }
 
+#[derive(clap::Args)]
+struct AttenuationArgs {
+    /// The light's radius (a sphere light's, or the size that sets a point light's curve).
+    #[arg(long, default_value_t = 0.5)]
+    radius: f32,
+    /// Its intensity in W/sr (a sphere light of radiance L has π r² L).
+    #[arg(long, default_value_t = 10.0)]
+    intensity: f32,
+    /// Irradiance below which light is dropped (the seed's I_c); sets d_max.
+    #[arg(long, default_value_t = 0.05)]
+    cutoff: f32,
+    /// d_max for the windows, overriding the one the cutoff implies.
+    #[arg(long)]
+    range: Option<f32>,
+    /// Output PNG.
+    #[arg(short, long, default_value = "attenuation.png")]
+    output: PathBuf,
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Render(args) => render(args),
         Command::Info { scene } => info(&scene),
         Command::Compare { image, reference, map } => compare(&image, &reference, map.as_deref()),
+        Command::Attenuation(args) => attenuation(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -110,6 +139,15 @@ fn render(args: RenderArgs) -> Result<(), String> {
     }
     if let Some(v) = args.seed {
         s.seed = v;
+    }
+    if let Some(model) = args.attenuation {
+        for light in &mut scene.lights {
+            if let Some(a) = light.attenuation() {
+                let a = a.with_model(model).map_err(|e| format!("--attenuation: {e}"))?;
+                *light = light.with_attenuation(a);
+            }
+        }
+        scene.light_culling = airlight::scene::LightCulling::new(&scene.lights);
     }
     let outputs = if args.output.is_empty() {
         vec![match &args.scene {
@@ -202,4 +240,73 @@ fn compare(a: &Path, b: &Path, map: Option<&Path>) -> Result<(), String> {
             .map_err(|e| format!("cannot write `{}`: {e}", map.display()))?;
     }
     Ok(())
+}
+
+fn attenuation(args: AttenuationArgs) -> Result<(), String> {
+    use airlight::light::{Attenuation, AttenuationModel as M};
+    let positive = |v: f32, name: &str| {
+        if v.is_finite() && v > 0.0 { Ok(v) } else { Err(format!("--{name} must be a positive number, got {v}")) }
+    };
+    let r = positive(args.radius, "radius")?;
+    let e0 = positive(args.intensity, "intensity")? / (r * r);
+    let cutoff = positive(args.cutoff, "cutoff")?;
+    let range = args.range.map(|d| positive(d, "range")).transpose()?;
+    if cutoff >= e0 {
+        return Err(format!("--cutoff {cutoff} is not below the irradiance at the light's surface, I/r² = {e0}"));
+    }
+    let models = [
+        (M::Physical, "physical", airlight::Rgb::new(0.0, 0.0, 0.0)),
+        (M::Cutoff, "cutoff", airlight::Rgb::new(0.9, 0.1, 0.1)),
+        (M::WindowTan, "window_tan", airlight::Rgb::new(0.1, 0.5, 0.1)),
+        (M::WindowRational, "window_rational", airlight::Rgb::new(0.1, 0.2, 0.9)),
+        (M::WindowUe4, "window_ue4", airlight::Rgb::new(0.8, 0.45, 0.0)),
+    ];
+    let mut curves = Vec::new();
+    for (model, name, color) in models {
+        let a = Attenuation::new(model, r, e0, Some(cutoff), range)?;
+        println!("{name}: d_max = {}", a.range);
+        curves.push((a, name, color));
+    }
+    println!("sphere: same curve as physical (1/(d/r + 1)^2), d_max = inf");
+    let finite = curves.iter().map(|(a, ..)| a.range).filter(|d| d.is_finite()).fold(0.0, f32::max);
+    let x_max = 1.15 * finite;
+    let series = curves
+        .iter()
+        .map(|(a, name, color)| plot::Series {
+            label: if a.range.is_finite() { format!("{name} (d_max {:.2})", a.range) } else { name.to_string() },
+            color: *color,
+            points: (0..=600).map(|i| x_max * i as f32 / 600.0).map(|d| (d, a.factor(d))).collect(),
+        })
+        .collect();
+    let plot = plot::Plot {
+        title: format!("r = {r}, I = {}, I_c = {cutoff}", args.intensity),
+        x_label: "d, distance from the light's surface".into(),
+        y_label: "E / E0".into(),
+        x_max,
+        y_min: -5.0,
+        y_max: 0.0,
+        log_y: true,
+        series,
+    };
+    plot.render()
+        .write(&args.output, 0.0, scene::Tonemap::Clamp)
+        .map_err(|e| format!("cannot write `{}`: {e}", args.output.display()))?;
+    Ok(())
+}
+
+fn parse_attenuation(s: &str) -> Result<airlight::light::AttenuationModel, String> {
+    use airlight::light::AttenuationModel as M;
+    Ok(match s {
+        "physical" => M::Physical,
+        "sphere" => M::Sphere,
+        "cutoff" => M::Cutoff,
+        "window_tan" => M::WindowTan,
+        "window_rational" => M::WindowRational,
+        "window_ue4" => M::WindowUe4,
+        _ => {
+            return Err(format!(
+                "unknown attenuation `{s}`; expected physical, sphere, cutoff, window_tan, window_rational or window_ue4"
+            ));
+        }
+    })
 }

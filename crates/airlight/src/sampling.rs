@@ -28,7 +28,9 @@ impl Sampler {
         Self { rng: Pcg32::seed_from_u64(key) }
     }
 
+    /// A uniform number in [0, 1). (Not an Iterator: the stream never ends.)
     #[inline]
+    #[allow(clippy::should_implement_trait)]
     pub fn next(&mut self) -> f32 {
         self.rng.random::<f32>()
     }

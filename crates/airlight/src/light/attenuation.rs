@@ -84,6 +84,15 @@ impl Attenuation {
         Ok(Attenuation { model, radius, range, relative_cutoff })
     }
 
+    /// The same light's falloff under another model, keeping its radius and
+    /// cutoff (or, without a cutoff, its range).
+    pub fn with_model(&self, model: AttenuationModel) -> Result<Self, String> {
+        let cutoff = (self.relative_cutoff > 0.0).then_some(self.relative_cutoff);
+        let range = self.range.is_finite().then_some(self.range);
+        // With E₀ = 1 the cutoff is the relative one.
+        Attenuation::new(model, self.radius, 1.0, cutoff, range)
+    }
+
     /// f(d) for distance d from the light's surface: 1 at d = 0.
     pub fn factor(&self, d: f32) -> f32 {
         let d = d.max(0.0);

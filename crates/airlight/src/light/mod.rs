@@ -106,6 +106,16 @@ impl Light {
         self
     }
 
+    /// The light's falloff, for point, spot and sphere lights.
+    pub fn attenuation(&self) -> Option<Attenuation> {
+        match *self {
+            Light::Point { attenuation, .. } | Light::Spot { attenuation, .. } | Light::Sphere { attenuation, .. } => {
+                Some(attenuation)
+            }
+            _ => None,
+        }
+    }
+
     /// Where a light with a finite range reaches: its centre and the
     /// distance from the centre beyond which it gives nothing. None for
     /// lights that reach everywhere.
