@@ -64,6 +64,71 @@ impl Material {
     }
 }
 
+/// A direction drawn from a material's BRDF.
+#[derive(Clone, Copy, Debug)]
+pub struct BsdfSample {
+    pub wi: Vec3,
+    /// The BRDF value f(wo, wi).
+    pub f: Rgb,
+    /// Solid-angle pdf of wi.
+    pub pdf: f32,
+}
+
+impl Material {
+    /// Chance of sampling the Phong lobe rather than the diffuse part: the
+    /// lobe's share of the two weights (largest channels).
+    fn lobe_probability(&self, p: Vec3, n: Vec3) -> f32 {
+        match *self {
+            Material::Phong { specular, .. } => {
+                let (d, s) = (self.albedo(p, n).max_element(), specular.max_element());
+                if d + s > 0.0 { s / (d + s) } else { 0.0 }
+            }
+            _ => 0.0,
+        }
+    }
+
+    /// Solid-angle pdf with which [`Material::sample`] draws `wi`.
+    pub fn pdf(&self, p: Vec3, n: Vec3, wo: Vec3, wi: Vec3) -> f32 {
+        // Directions are drawn on wo's side; `n` itself still picks the
+        // checker's square.
+        let facing = if n.dot(wo) < 0.0 { -n } else { n };
+        let cos = facing.dot(wi);
+        if cos <= 0.0 {
+            return 0.0;
+        }
+        let diffuse = cos / PI;
+        match *self {
+            Material::Phong { exponent, .. } => {
+                let ps = self.lobe_probability(p, n);
+                let mirror = 2.0 * facing.dot(wo) * facing - wo;
+                let c = mirror.dot(wi).max(0.0);
+                (1.0 - ps) * diffuse + ps * (exponent + 1.0) / (2.0 * PI) * c.powf(exponent)
+            }
+            _ => diffuse,
+        }
+    }
+
+    /// Draws an incident direction for outgoing `wo`: cosine-weighted for
+    /// the diffuse part, cos^n around the mirror direction for the Phong
+    /// lobe (Lafortune and Willems 1994), chosen by `u_lobe`. None if the
+    /// draw falls below the surface.
+    pub fn sample(&self, p: Vec3, n: Vec3, wo: Vec3, u: glam::Vec2, u_lobe: f32) -> Option<BsdfSample> {
+        let facing = if n.dot(wo) < 0.0 { -n } else { n };
+        let wi = if u_lobe < self.lobe_probability(p, n) {
+            let Material::Phong { exponent, .. } = *self else { unreachable!() };
+            let mirror = 2.0 * facing.dot(wo) * facing - wo;
+            let cos_a = u.x.powf(1.0 / (exponent + 1.0));
+            let sin_a = (1.0 - cos_a * cos_a).max(0.0).sqrt();
+            let phi = 2.0 * PI * u.y;
+            crate::sampling::to_world(Vec3::new(sin_a * phi.cos(), sin_a * phi.sin(), cos_a), mirror)
+        } else {
+            crate::sampling::to_world(crate::sampling::cosine_hemisphere(u), facing)
+        };
+        let pdf = self.pdf(p, n, wo, wi);
+        (pdf > 0.0).then(|| BsdfSample { wi, f: self.brdf(p, n, wo, wi), pdf })
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -100,6 +165,27 @@ mod tests {
         let f1 = m.brdf(Vec3::ZERO, Vec3::Z, wo, wi);
         let f2 = m.brdf(Vec3::ZERO, Vec3::Z, wi, wo);
         assert!((f1 - f2).length() < 1e-5);
+    }
+
+    #[test]
+    fn sampled_directions_estimate_the_directional_albedo() {
+        // E[f cos / pdf] over the material's own samples equals the albedo
+        // computed by uniform sampling: checks pdf and sample agree.
+        for m in [Material::diffuse(Rgb::splat(0.7)), Material::phong(Rgb::splat(0.3), Rgb::splat(0.5), 15.0)] {
+            let wo = Vec3::new(0.3, -0.2, 0.9).normalize();
+            let reference = directional_albedo(&m, wo, 400_000);
+            let mut s = Sampler::for_pixel(8, 8, 8);
+            let n = 400_000;
+            let mut sum = Rgb::ZERO;
+            for _ in 0..n {
+                if let Some(b) = m.sample(Vec3::ZERO, Vec3::Z, wo, s.next2(), s.next()) {
+                    sum += b.f * b.wi.z.abs() / b.pdf;
+                    assert!((m.pdf(Vec3::ZERO, Vec3::Z, wo, b.wi) - b.pdf).abs() < 1e-4 * b.pdf.max(1.0));
+                }
+            }
+            let est = sum / n as f32;
+            assert!((est.x - reference.x).abs() < 0.01, "{m:?}: {est} vs {reference}");
+        }
     }
 
     #[test]

@@ -5,7 +5,7 @@ use crate::Rgb;
 use crate::film::Image;
 use crate::integrator::{self, Integrator};
 use crate::sampling::Sampler;
-use crate::scene::Scene;
+use crate::scene::{PixelFilter, Scene};
 use glam::Vec2;
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -93,7 +93,12 @@ pub fn render_pixel(scene: &Scene, integrator: &dyn Integrator, x: u32, y: u32, 
     let mut sum = Rgb::ZERO;
     for i in 0..s.spp as u64 {
         let mut sampler = Sampler::for_pixel(s.seed, index, pass * s.spp as u64 + i);
-        let film = Vec2::new(x as f32, y as f32) + sampler.next2();
+        let jitter = sampler.next2();
+        let film = Vec2::new(x as f32, y as f32)
+            + match s.filter {
+                PixelFilter::Box => jitter,
+                PixelFilter::Point => Vec2::splat(0.5),
+            };
         let lens = sampler.next2();
         let ray = scene.camera.ray(film, s.width, s.height, lens);
         let l = integrator.radiance(scene, &ray, &mut sampler);

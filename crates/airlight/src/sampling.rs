@@ -87,6 +87,12 @@ pub fn concentric_disk(u: Vec2) -> Vec2 {
     Vec2::new(r * theta.cos(), r * theta.sin())
 }
 
+/// A cosine-weighted direction about +z (Malley's method); pdf = cos θ/π.
+pub fn cosine_hemisphere(u: Vec2) -> Vec3 {
+    let d = concentric_disk(u);
+    Vec3::new(d.x, d.y, (1.0 - d.length_squared()).max(0.0).sqrt())
+}
+
 /// A direction uniformly inside the cone of half angle θmax around +z, given
 /// cos θmax; pdf = 1 / (2π (1 − cos θmax)).
 pub fn uniform_cone(u: Vec2, cos_theta_max: f32) -> Vec3 {

@@ -2,9 +2,11 @@
 //! They share one trait; the scene's `[render] integrator` picks one.
 
 mod direct;
+pub mod path;
 mod raymarch;
 
 pub use direct::Direct;
+pub use path::PathTracer;
 pub use raymarch::Raymarch;
 
 use crate::Rgb;
@@ -83,7 +85,8 @@ pub fn for_scene(scene: &Scene) -> Result<Box<dyn Integrator>, String> {
     match s.integrator {
         IntegratorKind::Direct => Ok(Box::new(Direct)),
         IntegratorKind::Raymarch => Ok(Box::new(Raymarch { steps: s.steps, jitter: s.jitter })),
-        other => Err(format!("the `{other}` integrator is not implemented yet; available: direct, raymarch")),
+        IntegratorKind::Path => Ok(Box::new(PathTracer { max_depth: s.max_depth })),
+        other => Err(format!("the `{other}` integrator is not implemented yet; available: direct, raymarch, path")),
     }
 }
 

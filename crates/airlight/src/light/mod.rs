@@ -195,6 +195,31 @@ impl Light {
         }
     }
 
+    /// Solid-angle pdf with which [`Light::sample`] picks direction `wi` from
+    /// `p`, for an area light that the ray p + t·wi meets at distance `t`;
+    /// 0 for lights sampled as points.
+    pub fn pdf(&self, p: Vec3, wi: Vec3, t: f32) -> f32 {
+        match *self {
+            Light::Sphere { center, radius, attenuation, .. } if attenuation.model == AttenuationModel::Physical => {
+                let dc2 = (center - p).length_squared();
+                let r2 = radius * radius;
+                if dc2 <= r2 {
+                    return 1.0 / (4.0 * std::f32::consts::PI);
+                }
+                let sin2 = r2 / dc2;
+                let one_minus_cos = sin2 / (1.0 + (1.0 - sin2).max(0.0).sqrt());
+                1.0 / (2.0 * std::f32::consts::PI * one_minus_cos)
+            }
+            Light::Quad { edge_u, edge_v, .. } => {
+                let normal_area = edge_u.cross(edge_v);
+                let area = normal_area.length();
+                let cos_light = -wi.dot(normal_area) / area;
+                if cos_light <= 0.0 { 0.0 } else { t * t / (area * cos_light) }
+            }
+            _ => 0.0,
+        }
+    }
+
     /// Radiance leaving the light's surface toward `-dir` at a point whose
     /// outward normal is `n` (area lights; zero for others).
     pub fn emitted(&self, n: Vec3, dir: Vec3) -> Rgb {

@@ -3,7 +3,7 @@
 
 mod phase;
 
-pub use phase::{henyey_greenstein, isotropic};
+pub use phase::{henyey_greenstein, isotropic, sample_henyey_greenstein_cos};
 
 use crate::Rgb;
 use glam::Vec3;

@@ -143,6 +143,9 @@ impl Checker<'_> {
         if let Some(c) = r.cull_lights {
             s.cull_lights = c;
         }
+        if let Some(f) = r.filter {
+            s.filter = f;
+        }
         Ok(s)
     }
 

@@ -44,6 +44,7 @@ pub struct RenderDesc {
     pub tonemap: Option<Tonemap>,
     pub jitter: Option<bool>,
     pub cull_lights: Option<bool>,
+    pub filter: Option<crate::scene::PixelFilter>,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]

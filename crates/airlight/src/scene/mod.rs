@@ -56,6 +56,20 @@ pub struct RenderSettings {
     pub jitter: bool,
     /// Skip lights whose range ends before a point (finite-range falloffs).
     pub cull_lights: bool,
+    /// How a pixel gathers its samples.
+    pub filter: PixelFilter,
+}
+
+/// How the samples of a pixel are placed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum PixelFilter {
+    /// The mean over the pixel's square: samples jittered across it (anti-aliasing).
+    #[default]
+    Box,
+    /// Every sample through the pixel's centre: no anti-aliasing, but images
+    /// whose integrators take different sample counts share their camera rays.
+    Point,
 }
 
 impl Default for RenderSettings {
@@ -74,6 +88,7 @@ impl Default for RenderSettings {
             tonemap: Tonemap::Clamp,
             jitter: true,
             cull_lights: true,
+            filter: PixelFilter::Box,
         }
     }
 }
