@@ -234,6 +234,9 @@ fn compare(a: &Path, b: &Path, map: Option<&Path>) -> Result<(), String> {
     println!("mae: {}", e.mae);
     println!("max: {}", e.max);
     println!("rel_rmse: {}", e.rel_rmse);
+    let (ma, mb) = (image.mean(), reference.mean());
+    println!("mean_a: {} {} {}", ma.x, ma.y, ma.z);
+    println!("mean_b: {} {} {}", mb.x, mb.y, mb.z);
     if let Some(map) = map {
         film::error_map(&image, &reference, e.max as f32)
             .write(map, 0.0, scene::Tonemap::Clamp)

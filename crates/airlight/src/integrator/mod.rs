@@ -119,7 +119,8 @@ pub(crate) fn surface_radiance(
         }
         let origin = offset_origin(surface.p, surface.n, sample.wi);
         let distance = scene.light_distance(sample.distance);
-        if scene.geometry.occluded(origin, sample.wi, distance * (1.0 - 1e-4)) {
+        if scene.geometry.occluded(origin, sample.wi, scene.shadow_span(surface.p, origin, sample.wi, sample.distance))
+        {
             return;
         }
         let mut contribution = f * sample.weight * cos;

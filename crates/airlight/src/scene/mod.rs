@@ -117,6 +117,17 @@ impl Scene {
         if distance.is_finite() { distance } else { 2.0 * self.bounds_radius }
     }
 
+    /// How far a shadow ray from `origin` toward a light sample at
+    /// `p + wi·distance` may go: to just short of the sample. `origin` is `p`
+    /// moved off its surface, so the span is measured from it: measured from
+    /// `p`, a ray leaving a point lifted toward the light would reach the
+    /// light's own surface before its end and call it a blocker.
+    #[inline]
+    pub fn shadow_span(&self, p: Vec3, origin: Vec3, wi: Vec3, distance: f32) -> f32 {
+        let d = self.light_distance(distance) - (origin - p).dot(wi);
+        d * (1.0 - 1e-4)
+    }
+
     /// Calls `f(index, light)` for every light that may reach `p`, in index
     /// order: with culling, lights whose range ends before `p` are skipped
     /// without being looked at.

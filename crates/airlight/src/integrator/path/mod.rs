@@ -216,7 +216,7 @@ fn direct_light(
             return;
         }
         let distance = scene.light_distance(ls.distance);
-        if scene.geometry.occluded(origin, ls.wi, distance * (1.0 - 1e-4)) {
+        if scene.geometry.occluded(origin, ls.wi, scene.shadow_span(p, origin, ls.wi, ls.distance)) {
             return;
         }
         let (mut t_ray, mut r_l, mut r_u) = (Rgb::ONE, Rgb::ONE, Rgb::ONE);
