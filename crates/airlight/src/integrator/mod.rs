@@ -2,10 +2,12 @@
 //! They share one trait; the scene's `[render] integrator` picks one.
 
 mod direct;
+mod radiosity;
 mod raymarch;
 
 pub use direct::Direct;
-pub use raymarch::Raymarch;
+pub use radiosity::RadiosityIntegrator;
+pub use raymarch::{Raymarch, in_scattered};
 
 use crate::Rgb;
 use crate::geometry::{Ray, SurfaceHit, offset_origin};
@@ -92,8 +94,9 @@ pub fn for_scene(scene: &Scene) -> Result<Box<dyn Integrator>, String> {
             steps: s.steps,
             jitter: s.jitter,
         })),
+        IntegratorKind::Radiosity => Ok(Box::new(RadiosityIntegrator::new(scene))),
         other => Err(format!(
-            "the `{other}` integrator is not implemented yet; available: direct, raymarch"
+            "the `{other}` integrator is not implemented yet; available: direct, raymarch, radiosity"
         )),
     }
 }

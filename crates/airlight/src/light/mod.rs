@@ -1,8 +1,10 @@
 //! Lights, in the units of DESIGN.md: point and spot `intensity` in W/sr,
 //! distant `irradiance` on a facing surface, sphere and quad `radiance`.
 
+mod keyframes;
 mod spot;
 
+pub use keyframes::Keyframes;
 pub use spot::{SpotProfile, spot_falloff};
 
 use crate::Rgb;

@@ -43,6 +43,14 @@ pub struct RenderDesc {
     pub exposure: Option<Spanned<f32>>,
     pub tonemap: Option<Tonemap>,
     pub jitter: Option<bool>,
+    /// Radiosity: patch side length in world units (default: 1/32 of the
+    /// largest extent of the bounded geometry).
+    pub patch_size: Option<Spanned<f32>>,
+    /// Radiosity: bounces of indirect light (default 1).
+    pub bounces: Option<Spanned<i64>>,
+    /// Radiosity: largest estimated form factor A/(π d²) of a cluster that a
+    /// patch links to as a whole (default 0.005).
+    pub link_threshold: Option<Spanned<f32>>,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
@@ -184,6 +192,17 @@ pub struct LightDesc {
     pub corner: Option<Point>,
     pub edge_u: Option<Point>,
     pub edge_v: Option<Point>,
+    /// The path the light moves along in animations; see
+    /// [`crate::light::Keyframes`].
+    pub keyframes: Option<Spanned<Vec<Spanned<KeyframeDesc>>>>,
+}
+
+/// One key of a moving light: `{ time = 0.0, position = [x, y, z] }`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct KeyframeDesc {
+    pub time: f32,
+    pub position: Point,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
