@@ -286,10 +286,10 @@ fn gi(args: GiArgs) -> Result<(), String> {
             st.patches, st.dropped, st.clusters
         );
         println!(
-            "links: {} ({} to patches, {} to clusters; {:.1} per patch)",
+            "links: {} ({} patch to patch, {} with a cluster; {:.1} per patch)",
             st.links,
-            st.links_to_patches,
-            st.links - st.links_to_patches,
+            st.links_patch_to_patch,
+            st.links - st.links_patch_to_patch,
             st.links as f64 / st.patches.max(1) as f64
         );
         println!("memory: {:.2} MiB", st.bytes as f64 / (1u64 << 20) as f64);

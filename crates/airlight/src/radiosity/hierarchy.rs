@@ -5,9 +5,12 @@
 //! Bunnell's dynamic AO and Macklin's bottom-up clustering). Here the tree is
 //! built top-down: the patches of a node are split into [`BRANCHING`] groups
 //! by k-means (k-means++ seeding, Arthur and Vassilvitskii 2007; then Lloyd
-//! iterations) on the six numbers (position, w·normal), w being a quarter of
-//! the node's extent, so that a cluster holds patches that are close and
-//! face the same way; groups are split again until they hold at most
+//! iterations) on the six numbers (position, w·normal), w being the node's
+//! extent (the diagonal of its centres' bounding box), so that a cluster
+//! holds patches that are close and face the same way (a cluster mixing a
+//! bright floor with a dim wall, gathered as one mean radiosity, is what
+//! makes the hierarchical answer err; on the Cornell box, w = extent gave
+//! a third less error than w = extent/4 or 4 × extent); groups are split again until they hold at most
 //! [`BRANCHING`] patches. Each split is seeded from its own patch range, so
 //! the tree depends only on the patches and the seed.
 //!
@@ -36,6 +39,16 @@ pub struct Cluster {
     pub radius: f32,
     /// Total area of its patches.
     pub area: f32,
+    /// Unit area-weighted mean of its patches' normals (any unit vector when
+    /// they cancel out).
+    pub normal: Vec3,
+    /// The least cosine between `normal` and a patch's normal: 1 for a flat
+    /// cluster, ≤ 0 for one whose patches face apart.
+    pub cone_cos: f32,
+    /// Half the thickness of the slab around the plane through `center`
+    /// normal to `normal` that holds its patches (0 when they all lie in
+    /// one plane).
+    pub half_thickness: f32,
     /// Its children: `children[first..first + count]` of [`Hierarchy`].
     pub first_child: u32,
     pub child_count: u32,
@@ -96,6 +109,19 @@ pub fn build(patches: &mut Vec<Patch>, seed: u64) -> Hierarchy {
             .iter()
             .map(|p| p.center.distance(c.center) + p.radius)
             .fold(0.0, f32::max);
+        let normal: Vec3 = leaves.iter().map(|p| p.normal * p.area).sum();
+        c.normal = normal.normalize_or(Vec3::Z);
+        c.cone_cos = leaves
+            .iter()
+            .map(|p| p.normal.dot(c.normal))
+            .fold(1.0, f32::min);
+        c.half_thickness = leaves
+            .iter()
+            .map(|p| {
+                let cos = p.normal.dot(c.normal).clamp(-1.0, 1.0);
+                c.normal.dot(p.center - c.center).abs() + p.radius * (1.0 - cos * cos).sqrt()
+            })
+            .fold(0.0, f32::max);
     }
     h
 }
@@ -119,6 +145,9 @@ impl Builder<'_> {
             center: Vec3::ZERO,
             radius: 0.0,
             area: 0.0,
+            normal: Vec3::Z,
+            cone_cos: -1.0,
+            half_thickness: 0.0,
             first_child: 0,
             child_count: 0,
             start: start as u32,
@@ -144,7 +173,7 @@ impl Builder<'_> {
             let c = self.patches[i as usize].center;
             (lo.min(c), hi.max(c))
         });
-        let w = 0.25 * (hi - lo).length();
+        let w = (hi - lo).length();
         let feature = |i: u32| {
             let p = &self.patches[i as usize];
             [p.center, p.normal * w]

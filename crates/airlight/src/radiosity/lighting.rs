@@ -13,11 +13,15 @@ use crate::Rgb;
 use crate::geometry::offset_origin;
 use crate::light::Light;
 use crate::scene::Scene;
-use glam::Vec2;
+use glam::{Vec2, Vec3A};
 use rayon::prelude::*;
 
-/// Samples per patch for an area (sphere or quad) light, stratified 2×2.
-pub const AREA_LIGHT_SAMPLES: u32 = 4;
+/// Samples per patch for an area (sphere or quad) light. One suffices:
+/// a patch's direct light only feeds the bounce, where each receiver sums
+/// hundreds of sources whose sample positions differ (a fixed hash per
+/// patch, so a still light gives the same value every frame), while the
+/// integrator evaluates direct light per pixel.
+pub const AREA_LIGHT_SAMPLES: u32 = 1;
 /// Patches per parallel work item.
 const CHUNK: usize = 256;
 
@@ -43,11 +47,12 @@ fn patch_irradiance(scene: &Scene, p: &Patch, lights: &[Light], key: u64) -> Rgb
         ((key >> 16) & 0xffff) as f32 / 65536.0,
     );
     for light in lights {
-        let (count, side) = if light.is_delta() {
-            (1, 1)
+        let count = if light.is_delta() {
+            1
         } else {
-            (AREA_LIGHT_SAMPLES, 2)
+            AREA_LIGHT_SAMPLES
         };
+        let side = (count as f32).sqrt().ceil() as u32;
         let mut sum = Rgb::ZERO;
         for s in 0..count {
             let u = if light.is_delta() {
@@ -83,11 +88,11 @@ fn patch_irradiance(scene: &Scene, p: &Patch, lights: &[Light], key: u64) -> Rgb
 /// Sets every cluster's radiosity to the area-weighted mean of its
 /// children's: B_c = Σ A_k B_k / Σ A_k. `b` holds one value per node (the
 /// patches' first, then the clusters').
-pub fn push(patches: &[Patch], hierarchy: &Hierarchy, b: &mut [Rgb]) {
+pub fn push(patches: &[Patch], hierarchy: &Hierarchy, b: &mut [Vec3A]) {
     let n = patches.len();
     for (index, c) in hierarchy.clusters.iter().enumerate().rev() {
         let first = c.first_child as usize;
-        let mut sum = Rgb::ZERO;
+        let mut sum = Vec3A::ZERO;
         for &child in &hierarchy.children[first..first + c.child_count as usize] {
             let child = child as usize;
             let area = if child < n {
@@ -100,24 +105,41 @@ pub fn push(patches: &[Patch], hierarchy: &Hierarchy, b: &mut [Rgb]) {
         b[n + index] = if c.area > 0.0 {
             sum / c.area
         } else {
-            Rgb::ZERO
+            Vec3A::ZERO
         };
     }
 }
 
-/// Irradiance at every patch from the radiosity `b` of the nodes it links
-/// to: E_i = Σ_links F · B_source.
-pub fn gather(links: &Links, b: &[Rgb], out: &mut [Rgb]) {
+/// Irradiance gathered by every node from the radiosity `b` of the nodes
+/// it links to: E_r = Σ_links F · B_source.
+pub fn gather(links: &Links, b: &[Vec3A], out: &mut [Rgb]) {
     out.par_chunks_mut(CHUNK)
         .enumerate()
         .for_each(|(c, chunk)| {
             for (k, e) in chunk.iter_mut().enumerate() {
                 let i = c * CHUNK + k;
-                let mut sum = Rgb::ZERO;
+                let mut sum = Vec3A::ZERO;
                 for link in links.of(i) {
                     sum += b[link.source as usize] * link.factor;
                 }
-                *e = sum;
+                *e = sum.into();
             }
         });
+}
+
+/// Hands each cluster's gathered irradiance down to its patches: a patch's
+/// irradiance is the sum of what it and every cluster above it gathered
+/// (the "push" of Hanrahan, Salzman and Aupperle's PushPull; irradiance, not
+/// power, so children inherit their parent's value unchanged).
+pub fn push_down(hierarchy: &Hierarchy, n: usize, e: &mut [Rgb]) {
+    for (index, c) in hierarchy.clusters.iter().enumerate() {
+        let parent = e[n + index];
+        if parent == Rgb::ZERO {
+            continue;
+        }
+        let first = c.first_child as usize;
+        for &child in &hierarchy.children[first..first + c.child_count as usize] {
+            e[child as usize] += parent;
+        }
+    }
 }

@@ -9,8 +9,9 @@
 //! fraction of the light leaving a small area at i that reaches j, and, by
 //! reciprocity, the irradiance at i from j per unit radiosity of j:
 //! E_i = Σ_j F_ij B_j. It holds when r is large beside the patches; for
-//! patches closer than [`NEAR`] × (sum of their radii), F_ij is averaged over
-//! 4×4 points on each patch (equal-area sub-pieces) instead. Visibility
+//! patches closer than [`NEAR`] × (sum of their radii), F_ij is the exact
+//! point-to-polygon factor ([`point_polygon_factor`]) averaged over 4×4
+//! equal-area points of i instead. Visibility
 //! multiplies it: one ray between the centres for distant pairs, the fraction
 //! of 4 unblocked rays between points of both patches for near ones. Both use
 //! the same segments from either end, so A_i F_ij = A_j F_ji holds for
@@ -30,7 +31,7 @@
 
 use super::hierarchy::{Hierarchy, mix};
 use super::patches::Patch;
-use crate::geometry::{Geometry, Ray, offset_origin};
+use crate::geometry::{Geometry, offset_origin};
 use glam::Vec3;
 use rayon::prelude::*;
 use std::f32::consts::PI;
@@ -39,12 +40,12 @@ use std::f32::consts::PI;
 /// points of both patches.
 pub const NEAR: f32 = 2.0;
 /// Patches a cluster link's factor is estimated from.
-pub const CLUSTER_SAMPLES: usize = 16;
+pub const CLUSTER_SAMPLES: usize = 8;
 /// Rays for the visibility of a near pair.
 pub const NEAR_RAYS: usize = 4;
-const QUAD_N: usize = 4;
+const QUAD_N: usize = 6;
 
-/// One source a patch gathers from: a node id (patch or cluster) and the
+/// One source a node gathers from: a node id (patch or cluster) and the
 /// form factor to it.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Link {
@@ -52,14 +53,14 @@ pub struct Link {
     pub factor: f32,
 }
 
-/// Every patch's links, in one array: patch i's are
-/// `links[offsets[i]..offsets[i + 1]]`.
+/// Every node's links, in one array: node r's are
+/// `links[offsets[r]..offsets[r + 1]]` (patches first, then clusters).
 #[derive(Clone, Debug, Default)]
 pub struct Links {
     pub offsets: Vec<u32>,
     pub links: Vec<Link>,
-    /// How many links go to single patches (the rest go to clusters).
-    pub to_patches: usize,
+    /// How many links join two single patches.
+    pub patch_to_patch: usize,
 }
 
 impl Links {
@@ -100,8 +101,77 @@ pub fn is_near(a: &Patch, b: &Patch) -> bool {
     a.center.distance(b.center) < NEAR * (a.radius + b.radius)
 }
 
+/// The exact unoccluded form factor from a point `x` with normal `n` to the
+/// flat polygon `poly` whose front side faces along `m`, by Lambert's
+/// contour formula (Cohen and Wallace 1993, §4.5; Baum, Rushmeier and
+/// Winget 1989):
+///
+///   F = 1/(2π) · Σ_k γ_k · n · (R_k × R_{k+1}) / |R_k × R_{k+1}|,
+///
+/// R_k = v_k − x and γ_k the angle between R_k and R_{k+1}, after clipping
+/// the polygon to the half space in front of x. Zero when x is behind the
+/// polygon's front side.
+pub fn point_polygon_factor(x: Vec3, n: Vec3, poly: &[Vec3], m: Vec3) -> f32 {
+    if m.dot(x - poly[0]) <= 0.0 {
+        return 0.0;
+    }
+    // Clip to n·(v − x) ≥ 0 (Sutherland–Hodgman against one plane).
+    let mut clipped = [Vec3::ZERO; 8];
+    let mut count = 0;
+    for k in 0..poly.len() {
+        let (a, b) = (poly[k], poly[(k + 1) % poly.len()]);
+        let (da, db) = (n.dot(a - x), n.dot(b - x));
+        if da >= 0.0 {
+            clipped[count] = a;
+            count += 1;
+        }
+        if (da >= 0.0) != (db >= 0.0) {
+            clipped[count] = a + (b - a) * (da / (da - db));
+            count += 1;
+        }
+    }
+    if count < 3 {
+        return 0.0;
+    }
+    let mut sum = 0.0;
+    for k in 0..count {
+        let (a, b) = (clipped[k] - x, clipped[(k + 1) % count] - x);
+        let c = a.cross(b);
+        let len = c.length();
+        if len <= 1e-12 * a.length() * b.length() {
+            continue;
+        }
+        let gamma = len.atan2(a.dot(b));
+        sum += gamma * n.dot(c) / len;
+    }
+    (sum / (2.0 * PI)).abs()
+}
+
+fn polygon(p: &Patch) -> ([Vec3; 4], usize) {
+    let s = &p.shape;
+    if s.triangle {
+        ([s.origin, s.origin + s.e1, s.origin + s.e2, Vec3::ZERO], 3)
+    } else {
+        (
+            [
+                s.origin,
+                s.origin + s.e1,
+                s.origin + s.e1 + s.e2,
+                s.origin + s.e2,
+            ],
+            4,
+        )
+    }
+}
+
 /// The unoccluded form factor F_ij from patch i to patch j (see the module
-/// documentation): at i's centre when far, averaged over both when near.
+/// documentation): the point formula at i's centre when far; when near,
+/// the mean of the two one-sided estimates F_ij and (A_j/A_i)·F_ji, each the
+/// exact point-to-polygon factor averaged over 6×6 equal-area points of the
+/// receiver. One side's integrand may jump (a floor patch half under a
+/// block sees the block's face from one half only), where midpoint
+/// quadrature errs by a few per cent; averaging halves that and makes the
+/// near factors exactly reciprocal, A_i F_ij = A_j F_ji.
 pub fn form_factor(pi: &Patch, pj: &Patch) -> f32 {
     let d = pj.center - pi.center;
     // All of j behind i, or i behind j: nothing passes.
@@ -111,16 +181,28 @@ pub fn form_factor(pi: &Patch, pj: &Patch) -> f32 {
     if !is_near(pi, pj) {
         return point_factor(pi.center, pi.normal, pj.center, pj.normal, pj.area);
     }
+    let forward = one_sided_factor(pi, pj);
+    let backward = one_sided_factor(pj, pi);
+    0.5 * (forward + backward * pj.area / pi.area)
+}
+
+fn one_sided_factor(pi: &Patch, pj: &Patch) -> f32 {
     let (a, na) = quad_points(pi);
-    let (b, nb) = quad_points(pj);
-    let piece = pj.area / nb as f32;
+    let (poly, count) = polygon(pj);
+    // The exact factor is to the patch's polygon; scale to its stated area
+    // (they differ only for the tangent pieces of a sphere).
+    let poly_area =
+        if pj.shape.triangle { 0.5 } else { 1.0 } * pj.shape.e1.cross(pj.shape.e2).length();
+    let scale = if poly_area > 0.0 {
+        pj.area / poly_area
+    } else {
+        0.0
+    };
     let mut sum = 0.0;
     for x in &a[..na] {
-        for y in &b[..nb] {
-            sum += point_factor(*x, pi.normal, *y, pj.normal, piece);
-        }
+        sum += point_polygon_factor(*x, pi.normal, &poly[..count], pj.normal);
     }
-    sum / na as f32
+    scale * sum / na as f32
 }
 
 /// Whether the segment between `x` (normal `n`) and `y` (normal `m`) is
@@ -141,12 +223,11 @@ pub fn segment_clear(geometry: &Geometry, x: Vec3, n: Vec3, y: Vec3, m: Vec3) ->
 /// when far, [`NEAR_RAYS`] rays between points of both when near. Symmetric
 /// in (i, j): both orders test the same segments.
 pub fn visibility(geometry: &Geometry, patches: &[Patch], i: usize, j: usize, seed: u64) -> f32 {
-    let (pi, pj) = (&patches[i], &patches[j]);
-    if !is_near(pi, pj) {
-        return segment_clear(geometry, pi.center, pi.normal, pj.center, pj.normal) as u32 as f32;
-    }
     let (lo, hi) = (i.min(j), i.max(j));
     let (a, b) = (&patches[lo], &patches[hi]);
+    if !is_near(a, b) {
+        return segment_clear(geometry, a.center, a.normal, b.center, b.normal) as u32 as f32;
+    }
     let key = mix(seed ^ mix(((lo as u64) << 32) | hi as u64));
     let mut clear = 0;
     for k in 0..NEAR_RAYS {
@@ -162,17 +243,20 @@ pub fn visibility(geometry: &Geometry, patches: &[Patch], i: usize, j: usize, se
     clear as f32 / NEAR_RAYS as f32
 }
 
-/// Builds every patch's links (in parallel; the result does not depend on
-/// the number of threads). `threshold`: see the module documentation; with
-/// threshold 0 every link goes to a single patch, the full O(N²) solution.
+/// Builds the links of every node (in parallel; the result does not depend
+/// on the number of threads). `threshold`: see the module documentation;
+/// with threshold 0 every link joins two single patches, the full O(N²)
+/// solution.
 pub fn build(
     patches: &[Patch],
     hierarchy: &Hierarchy,
     geometry: &Geometry,
     threshold: f32,
+    receiver_share: f32,
     seed: u64,
 ) -> Links {
     let n = patches.len();
+    let nodes = n + hierarchy.clusters.len();
     // Prefix sums of area, for picking a cluster's patches ∝ area.
     let mut cdf = Vec::with_capacity(n + 1);
     let mut acc = 0.0f64;
@@ -186,139 +270,228 @@ pub fn build(
         hierarchy,
         geometry,
         threshold,
+        receiver_share,
         seed,
         cdf: &cdf,
     };
+    let mut pairs = Vec::new();
+    if n > 0 {
+        ctx.refine(hierarchy.root, hierarchy.root, &mut pairs);
+    }
+    // Group by receiver; the sort is stable and `pairs` comes out in one
+    // order whatever the threads, so the links do too.
+    // Sources in increasing order within each receiver, so that gathering
+    // walks the radiosity array forward.
+    pairs.sort_by_key(|&(r, l)| (r, l.source));
     let mut out = Links {
-        offsets: Vec::with_capacity(n + 1),
-        links: Vec::new(),
-        to_patches: 0,
+        offsets: Vec::with_capacity(nodes + 1),
+        links: Vec::with_capacity(pairs.len()),
+        patch_to_patch: 0,
     };
     out.offsets.push(0);
-    // In chunks, so that the per-patch vectors do not all live at once.
-    for chunk in (0..n).collect::<Vec<_>>().chunks(4096) {
-        let lists: Vec<Vec<Link>> = chunk
-            .par_iter()
-            .map(|&i| ctx.links_of(i, &mut Vec::new()))
-            .collect();
-        for list in lists {
-            out.to_patches += list.iter().filter(|l| (l.source as usize) < n).count();
-            out.links.extend(list);
-            out.offsets.push(out.links.len() as u32);
+    let mut k = 0;
+    for r in 0..nodes as u32 {
+        while k < pairs.len() && pairs[k].0 == r {
+            let link = pairs[k].1;
+            if (r as usize) < n && (link.source as usize) < n {
+                out.patch_to_patch += 1;
+            }
+            out.links.push(link);
+            k += 1;
         }
+        out.offsets.push(out.links.len() as u32);
     }
-    out.links.shrink_to_fit();
     out
 }
+
+/// A node's shape, for refinement: a patch seen as a flat cluster of one.
+#[derive(Clone, Copy)]
+struct Node {
+    center: Vec3,
+    radius: f32,
+    area: f32,
+    normal: Vec3,
+    cone_cos: f32,
+    half_thickness: f32,
+    start: u32,
+    end: u32,
+    leaf: bool,
+}
+
+/// Receiving clusters must be this flat: their patches take one irradiance.
+const COHERENT: f32 = 0.95;
+/// Pairs holding more patches than this together are refined in parallel.
+const PARALLEL: u32 = 2048;
 
 struct Context<'a> {
     patches: &'a [Patch],
     hierarchy: &'a Hierarchy,
     geometry: &'a Geometry,
     threshold: f32,
+    receiver_share: f32,
     seed: u64,
     cdf: &'a [f64],
 }
 
 impl Context<'_> {
-    fn links_of(&self, i: usize, stack: &mut Vec<u32>) -> Vec<Link> {
+    fn node(&self, id: u32) -> Node {
         let n = self.patches.len() as u32;
-        let pi = &self.patches[i];
-        let mut links = Vec::new();
-        stack.clear();
-        stack.push(self.hierarchy.root);
-        while let Some(node) = stack.pop() {
-            if node < n {
-                let j = node as usize;
-                if j == i {
-                    continue;
-                }
-                let f = form_factor(pi, &self.patches[j]);
-                if f > 0.0 {
-                    let v = visibility(self.geometry, self.patches, i, j, self.seed);
-                    if v > 0.0 {
-                        links.push(Link {
-                            source: node,
-                            factor: f * v,
-                        });
-                    }
-                }
-                continue;
+        if id < n {
+            let p = &self.patches[id as usize];
+            Node {
+                center: p.center,
+                radius: p.radius,
+                area: p.area,
+                normal: p.normal,
+                cone_cos: 1.0,
+                half_thickness: 0.0,
+                start: id,
+                end: id + 1,
+                leaf: true,
             }
-            let c = &self.hierarchy.clusters[(node - n) as usize];
-            let d = c.center - pi.center;
-            if pi.normal.dot(d) + c.radius <= 0.0 {
-                continue;
+        } else {
+            let c = &self.hierarchy.clusters[(id - n) as usize];
+            Node {
+                center: c.center,
+                radius: c.radius,
+                area: c.area,
+                normal: c.normal,
+                cone_cos: c.cone_cos,
+                half_thickness: c.half_thickness,
+                start: c.start,
+                end: c.end,
+                leaf: false,
             }
-            let dist2 = d.length_squared();
-            let far = dist2 > 4.0 * c.radius * c.radius;
-            if far && c.area < self.threshold * PI * dist2 {
-                let f = self.cluster_factor(i, node, c);
-                if f > 0.0 {
-                    links.push(Link {
-                        source: node,
-                        factor: f,
-                    });
-                }
-                continue;
-            }
-            let first = c.first_child as usize;
-            stack
-                .extend_from_slice(&self.hierarchy.children[first..first + c.child_count as usize]);
         }
-        links
     }
 
-    fn cluster_factor(&self, i: usize, node: u32, c: &super::hierarchy::Cluster) -> f32 {
-        let pi = &self.patches[i];
-        let (lo, hi) = (self.cdf[c.start as usize], self.cdf[c.end as usize]);
-        let key = mix(self.seed ^ mix(((i as u64) << 32) | node as u64));
+    fn children(&self, id: u32) -> &[u32] {
+        let c = &self.hierarchy.clusters[id as usize - self.patches.len()];
+        let first = c.first_child as usize;
+        &self.hierarchy.children[first..first + c.child_count as usize]
+    }
+
+    /// Links receiver `r` to source `s`, or their parts to each other
+    /// (Hanrahan, Salzman and Aupperle's Refine, with clusters).
+    fn refine(&self, r: u32, s: u32, out: &mut Vec<(u32, Link)>) {
+        let (a, b) = (self.node(r), self.node(s));
+        if r == s && a.leaf {
+            return;
+        }
+        if behind(&a, &b) || behind(&b, &a) {
+            return;
+        }
+        if a.leaf && b.leaf {
+            let (i, j) = (r as usize, s as usize);
+            let f = form_factor(&self.patches[i], &self.patches[j]);
+            if f > 0.0 {
+                let v = visibility(self.geometry, self.patches, i, j, self.seed);
+                if v > 0.0 {
+                    out.push((
+                        r,
+                        Link {
+                            source: s,
+                            factor: f * v,
+                        },
+                    ));
+                }
+            }
+            return;
+        }
+        let d2 = a.center.distance_squared(b.center);
+        let sep = a.radius + b.radius;
+        let limit = self.threshold * PI * d2;
+        let separated = d2 > 4.0 * sep * sep;
+        let receiver_ok =
+            a.leaf || (a.cone_cos >= COHERENT && a.area < limit * self.receiver_share && separated);
+        let source_ok = b.leaf || (b.area < limit && separated);
+        if receiver_ok && source_ok {
+            let f = self.cluster_factor(r, &a, s, &b);
+            if f > 0.0 {
+                out.push((
+                    r,
+                    Link {
+                        source: s,
+                        factor: f,
+                    },
+                ));
+            }
+            return;
+        }
+        let split_receiver = if !receiver_ok && !source_ok {
+            a.area > b.area
+        } else {
+            !receiver_ok
+        };
+        let kids = self.children(if split_receiver { r } else { s });
+        let pair = |k: u32| if split_receiver { (k, s) } else { (r, k) };
+        if (a.end - a.start) + (b.end - b.start) > PARALLEL {
+            let parts: Vec<Vec<(u32, Link)>> = kids
+                .par_iter()
+                .map(|&k| {
+                    let mut v = Vec::new();
+                    let (x, y) = pair(k);
+                    self.refine(x, y, &mut v);
+                    v
+                })
+                .collect();
+            for p in parts {
+                out.extend(p);
+            }
+        } else {
+            for &k in kids {
+                let (x, y) = pair(k);
+                self.refine(x, y, out);
+            }
+        }
+    }
+
+    /// The patch under node `node` whose area interval holds the fraction
+    /// `u` of the node's area.
+    fn pick(&self, node: &Node, u: f64) -> usize {
+        let (lo, hi) = (self.cdf[node.start as usize], self.cdf[node.end as usize]);
+        let target = lo + u * (hi - lo);
+        let range = &self.cdf[node.start as usize + 1..=node.end as usize];
+        (node.start as usize + range.partition_point(|&x| x <= target)).min(node.end as usize - 1)
+    }
+
+    /// A_s · (1/M) Σ_m G(x_m, y_m) V(x_m, y_m), x_m and y_m patch centres
+    /// drawn ∝ area from r and s (stratified): an unbiased estimate of the
+    /// area-weighted mean over r's patches of Σ_{k ∈ s} F_ik.
+    fn cluster_factor(&self, r: u32, a: &Node, s: u32, b: &Node) -> f32 {
+        let key = mix(self.seed ^ mix(((r as u64) << 32) | s as u64));
+        let m_count = CLUSTER_SAMPLES;
         let mut sum = 0.0;
-        for m in 0..CLUSTER_SAMPLES {
-            let u = (m as f64
-                + (mix(key.wrapping_add(m as u64)) >> 11) as f64 / (1u64 << 53) as f64)
-                / CLUSTER_SAMPLES as f64;
-            let target = lo + u * (hi - lo);
-            // The patch k whose area interval holds `target`.
-            let k = (self.cdf[c.start as usize + 1..=c.end as usize]
-                .partition_point(|&x| x <= target)
-                + c.start as usize)
-                .min(c.end as usize - 1);
-            let pk = &self.patches[k];
-            let g = point_factor(pi.center, pi.normal, pk.center, pk.normal, 1.0);
-            if g > 0.0 && segment_clear(self.geometry, pi.center, pi.normal, pk.center, pk.normal) {
+        for m in 0..m_count {
+            let h = mix(key.wrapping_add(m as u64));
+            let frac = |bits: u64| (bits & 0x1f_ffff) as f64 / (1u64 << 21) as f64;
+            let ua = (m as f64 + frac(h)) / m_count as f64;
+            let ub = (((3 * m + 1) % m_count) as f64 + frac(h >> 21)) / m_count as f64;
+            let x = &self.patches[self.pick(a, ua)];
+            let y = &self.patches[self.pick(b, ub)];
+            let g = point_factor(x.center, x.normal, y.center, y.normal, 1.0);
+            if g > 0.0 && segment_clear(self.geometry, x.center, x.normal, y.center, y.normal) {
                 sum += g;
             }
         }
-        c.area * sum / CLUSTER_SAMPLES as f32
+        b.area * sum / m_count as f32
     }
 }
 
-/// Whether any of 16 cosine-distributed rays from the patch's centre hits a
-/// surface. A patch side that sees nothing exchanges (almost) no light —
-/// Σ_j F_ij is the fraction of cosine-distributed rays that hit — so such
-/// sides (the outside of a closed room) are dropped before linking.
-pub fn sees_anything(geometry: &Geometry, p: &Patch, key: u64) -> bool {
-    let h = mix(key);
-    let (ox, oy) = (
-        (h & 0xffff) as f32 / 65536.0,
-        ((h >> 16) & 0xffff) as f32 / 65536.0,
-    );
-    let origin_for = |d: Vec3| offset_origin(p.center, p.normal, d);
-    for a in 0..4 {
-        for b in 0..4 {
-            let u = glam::Vec2::new(
-                ((a as f32 + ox) / 4.0).fract(),
-                ((b as f32 + oy) / 4.0).fract(),
-            );
-            let disk = crate::sampling::concentric_disk(u);
-            let z = (1.0 - disk.length_squared()).max(0.0).sqrt();
-            let d = crate::sampling::to_world(Vec3::new(disk.x, disk.y, z), p.normal);
-            let ray = Ray::new(origin_for(d), d);
-            if geometry.intersect(&ray, f32::INFINITY).is_some() {
-                return true;
-            }
-        }
-    }
-    false
+/// Whether every point of `b` lies behind (or on) every patch of `a`:
+/// n_x · (y − x) ≤ 0 for all patches x of a with normal n_x and points y of
+/// b. Bounded by n̄·(c_b − c_a) + (b's extent along n̄) + a's half
+/// thickness + |n_x − n̄|·(distance + radii), |n_x − n̄|² ≤ 2 − 2·cone_cos.
+fn behind(a: &Node, b: &Node) -> bool {
+    let d = b.center - a.center;
+    let flat_and_parallel = b.cone_cos >= 0.9999 && a.normal.dot(b.normal).abs() >= 0.9999;
+    let extent = if flat_and_parallel {
+        b.half_thickness
+    } else {
+        b.radius
+    };
+    let spread = (2.0 - 2.0 * a.cone_cos).max(0.0).sqrt();
+    let bound =
+        a.normal.dot(d) + extent + a.half_thickness + spread * (d.length() + a.radius + b.radius);
+    bound <= 1e-5 * (d.length() + a.radius + b.radius)
 }

@@ -54,6 +54,13 @@ pub struct CompileParams {
     /// A/(π d²) is below this (and the receiver lies outside twice its
     /// bounding radius); 0 links every patch to every patch it sees.
     pub link_threshold: f32,
+    /// Clusters may receive light too (Hanrahan, Salzman and Aupperle's
+    /// two-sided refinement) when flat (normals within ~18°) and their own
+    /// estimated form factor is below `receiver_share × link_threshold`; the
+    /// irradiance a cluster gathers is handed down to its patches. 0 (the
+    /// default) lets only patches receive, as the seed does: on the Cornell
+    /// box receiver clusters saved fewer links than they cost in accuracy.
+    pub receiver_share: f32,
     /// Seeds the clustering and the sample positions.
     pub seed: u64,
 }
@@ -73,6 +80,7 @@ impl CompileParams {
         CompileParams {
             patch_size,
             link_threshold: s.link_threshold,
+            receiver_share: 0.0,
             seed: s.seed,
         }
     }
@@ -82,13 +90,14 @@ impl CompileParams {
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct CompileStats {
     pub patches: usize,
-    /// Patch sides dropped because they see nothing (see
-    /// [`links::sees_anything`]).
+    /// Patch sides dropped because nothing lies in front of them (see
+    /// [`patches::faces_anything`]).
     pub dropped: usize,
     pub clusters: usize,
     pub links: usize,
-    /// Links to single patches (the rest go to clusters).
-    pub links_to_patches: usize,
+    /// Links between two single patches (the rest have a cluster at one end
+    /// or both).
+    pub links_patch_to_patch: usize,
     /// Bytes held by patches, hierarchy, links, lookup grid and per-frame
     /// buffers.
     pub bytes: usize,
@@ -128,9 +137,10 @@ pub struct Radiosity {
     materials: Vec<Material>,
     direct: Vec<Rgb>,
     indirect: Vec<Rgb>,
-    /// Per node (patches, then clusters): radiosity.
-    node_b: Vec<Rgb>,
-    /// One bounce's gathered irradiance.
+    /// Per node (patches, then clusters): radiosity (16-byte aligned for
+    /// the gather's SIMD).
+    node_b: Vec<glam::Vec3A>,
+    /// Per node: one bounce's gathered irradiance.
     gathered: Vec<Rgb>,
 }
 
@@ -162,12 +172,14 @@ impl Radiosity {
         let cut = start.elapsed();
 
         let t = Instant::now();
+        let extents: Vec<patches::Extent> = scene
+            .objects
+            .iter()
+            .map(|(shape, _)| patches::Extent::of(shape))
+            .collect();
         let keep: Vec<bool> = patches
             .par_iter()
-            .enumerate()
-            .map(|(i, p)| {
-                links::sees_anything(&scene.geometry, p, params.seed ^ ((i as u64) << 20))
-            })
+            .map(|p| patches::faces_anything(p, &extents))
             .collect();
         let before = patches.len();
         let mut keep = keep.into_iter();
@@ -185,6 +197,7 @@ impl Radiosity {
             &hierarchy,
             &scene.geometry,
             params.link_threshold,
+            params.receiver_share,
             params.seed,
         );
         let link = t.elapsed();
@@ -199,8 +212,8 @@ impl Radiosity {
             materials: Vec::new(),
             direct: vec![Rgb::ZERO; n],
             indirect: vec![Rgb::ZERO; n],
-            node_b: vec![Rgb::ZERO; nodes],
-            gathered: vec![Rgb::ZERO; n],
+            node_b: vec![glam::Vec3A::ZERO; nodes],
+            gathered: vec![Rgb::ZERO; nodes],
             patches,
             hierarchy,
             links,
@@ -211,7 +224,7 @@ impl Radiosity {
             dropped,
             clusters: r.hierarchy.clusters.len(),
             links: r.links.links.len(),
-            links_to_patches: r.links.to_patches,
+            links_patch_to_patch: r.links.patch_to_patch,
             bytes: r.bytes(),
             cut,
             cull,
@@ -227,9 +240,9 @@ impl Radiosity {
             + (self.albedo.capacity()
                 + self.direct.capacity()
                 + self.indirect.capacity()
-                + self.gathered.capacity()
-                + self.node_b.capacity())
-                * size_of::<Rgb>();
+                + self.gathered.capacity())
+                * size_of::<Rgb>()
+            + self.node_b.capacity() * size_of::<glam::Vec3A>();
         per_patch + self.hierarchy.bytes() + self.links.bytes() + self.lookup.bytes()
     }
 
@@ -269,12 +282,13 @@ impl Radiosity {
                 &self.gathered
             };
             for i in 0..n {
-                self.node_b[i] = self.albedo[i] * source[i];
+                self.node_b[i] = (self.albedo[i] * source[i]).into();
             }
             lighting::push(&self.patches, &self.hierarchy, &mut self.node_b);
             times.push += t.elapsed();
             let t = Instant::now();
             lighting::gather(&self.links, &self.node_b, &mut self.gathered);
+            lighting::push_down(&self.hierarchy, n, &mut self.gathered);
             for (e, g) in self.indirect.iter_mut().zip(&self.gathered) {
                 *e += *g;
             }

@@ -352,3 +352,86 @@ fn cut_sphere(center: Vec3, r: f32, h: f32, out: &mut Vec<Patch>) {
         }
     }
 }
+
+/// What may lie in front of a patch: an object's bounding box, or an
+/// infinite plane.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Extent {
+    Bounds(Vec3, Vec3),
+    Plane { point: Vec3, normal: Vec3 },
+}
+
+impl Extent {
+    /// The extent of `shape`.
+    pub fn of(shape: &Shape) -> Extent {
+        match shape {
+            Shape::Plane { point, normal } => Extent::Plane {
+                point: *point,
+                normal: *normal,
+            },
+            Shape::Sphere { center, radius } => Extent::Bounds(center - *radius, center + *radius),
+            Shape::Quad {
+                corner,
+                edge_u,
+                edge_v,
+            } => Extent::points(&[
+                *corner,
+                corner + edge_u,
+                corner + edge_v,
+                corner + edge_u + edge_v,
+            ]),
+            Shape::Box { min, max } => Extent::Bounds(*min, *max),
+            Shape::Mesh { positions, .. } => Extent::points(positions),
+            Shape::Transformed {
+                shape,
+                world_from_local,
+            } => match Extent::of(shape) {
+                Extent::Bounds(lo, hi) => {
+                    let corners: Vec<Vec3> = (0..8)
+                        .map(|i| {
+                            world_from_local.transform_point3(Vec3::new(
+                                if i & 1 == 0 { lo.x } else { hi.x },
+                                if i & 2 == 0 { lo.y } else { hi.y },
+                                if i & 4 == 0 { lo.z } else { hi.z },
+                            ))
+                        })
+                        .collect();
+                    Extent::points(&corners)
+                }
+                plane => plane,
+            },
+        }
+    }
+
+    fn points(points: &[Vec3]) -> Extent {
+        let lo = points.iter().copied().fold(Vec3::MAX, Vec3::min);
+        let hi = points.iter().copied().fold(Vec3::MIN, Vec3::max);
+        Extent::Bounds(lo, hi)
+    }
+
+    /// Whether some of it lies strictly in front of the plane through `p`
+    /// with unit normal `n` (beyond a tolerance `eps`).
+    pub fn in_front(&self, p: Vec3, n: Vec3, eps: f32) -> bool {
+        match *self {
+            Extent::Bounds(lo, hi) => {
+                // The box corner farthest along n.
+                let far = Vec3::select(n.cmpge(Vec3::ZERO), hi, lo);
+                n.dot(far - p) > eps
+            }
+            Extent::Plane { point, normal } => {
+                let parallel = n.cross(normal).length_squared() < 1e-12;
+                !parallel || n.dot(point - p) > eps
+            }
+        }
+    }
+}
+
+/// Whether any object's extent lies in front of patch `p`. A side with
+/// nothing in front of it sees nothing and is seen by nothing, so it
+/// exchanges no light (the outside of a closed room, the underside of a
+/// floor): such sides are dropped before linking. Conservative: a side is
+/// kept whenever a bounding box reaches in front of it.
+pub fn faces_anything(p: &Patch, extents: &[Extent]) -> bool {
+    let eps = 1e-5 * (1.0 + p.center.abs().max_element());
+    extents.iter().any(|e| e.in_front(p.center, p.normal, eps))
+}

@@ -49,7 +49,7 @@ pub struct RenderDesc {
     /// Radiosity: bounces of indirect light (default 1).
     pub bounces: Option<Spanned<i64>>,
     /// Radiosity: largest estimated form factor A/(π d²) of a cluster that a
-    /// patch links to as a whole (default 0.005).
+    /// patch links to as a whole (default 0.02).
     pub link_threshold: Option<Spanned<f32>>,
 }
 

@@ -86,7 +86,7 @@ impl Default for RenderSettings {
 }
 
 /// Default of [`RenderSettings::link_threshold`].
-pub const DEFAULT_LINK_THRESHOLD: f32 = 0.005;
+pub const DEFAULT_LINK_THRESHOLD: f32 = 0.02;
 
 /// Everything a render needs, built and validated.
 #[derive(Debug)]
