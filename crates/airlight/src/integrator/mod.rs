@@ -132,10 +132,11 @@ pub(crate) fn surface_radiance(
         }
         let origin = offset_origin(surface.p, surface.n, sample.wi);
         let distance = scene.light_distance(sample.distance);
-        if scene
-            .geometry
-            .occluded(origin, sample.wi, distance * (1.0 - 1e-4))
-        {
+        if scene.geometry.occluded(
+            origin,
+            sample.wi,
+            shadow_distance(surface.p, origin, distance),
+        ) {
             continue;
         }
         let mut contribution = f * sample.weight * cos;
@@ -145,4 +146,13 @@ pub(crate) fn surface_radiance(
         radiance += contribution;
     }
     radiance
+}
+
+/// How far a shadow ray from `origin` (a surface point `p` lifted off its
+/// surface) toward a light sample `distance` from `p` may go without
+/// reaching the light's own surface: the distance less a relative margin
+/// and less the lift, which brings the origin up to |origin − p| closer.
+#[inline]
+pub fn shadow_distance(p: glam::Vec3, origin: glam::Vec3, distance: f32) -> f32 {
+    distance * (1.0 - 1e-4) - (origin - p).length()
 }

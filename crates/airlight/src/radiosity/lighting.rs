@@ -72,10 +72,8 @@ fn patch_irradiance(scene: &Scene, p: &Patch, lights: &[Light], key: u64) -> Rgb
             }
             let origin = offset_origin(p.center, p.normal, sample.wi);
             let distance = scene.light_distance(sample.distance);
-            if scene
-                .geometry
-                .occluded(origin, sample.wi, distance * (1.0 - 1e-4))
-            {
+            let reach = crate::integrator::shadow_distance(p.center, origin, distance);
+            if scene.geometry.occluded(origin, sample.wi, reach) {
                 continue;
             }
             sum += sample.weight * cos;
