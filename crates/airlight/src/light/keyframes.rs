@@ -57,7 +57,8 @@ impl Keyframes {
         let keys = &self.keys;
         let first = keys[0];
         let last = keys[keys.len() - 1];
-        if !(time > first.0) {
+        // Before the first key, or NaN: the first key.
+        if time.partial_cmp(&first.0) != Some(std::cmp::Ordering::Greater) {
             return first.1;
         }
         if time >= last.0 {

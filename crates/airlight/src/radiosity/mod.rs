@@ -281,8 +281,8 @@ impl Radiosity {
             } else {
                 &self.gathered
             };
-            for i in 0..n {
-                self.node_b[i] = (self.albedo[i] * source[i]).into();
+            for ((b, a), e) in self.node_b[..n].iter_mut().zip(&self.albedo).zip(source) {
+                *b = (*a * *e).into();
             }
             lighting::push(&self.patches, &self.hierarchy, &mut self.node_b);
             times.push += t.elapsed();

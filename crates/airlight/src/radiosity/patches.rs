@@ -207,7 +207,7 @@ fn push_flat(shape: PatchShape, normal: Vec3, two_sided: bool, out: &mut Vec<Pat
     } else {
         (cross, shape.origin + 0.5 * (shape.e1 + shape.e2))
     };
-    if !(area > 0.0) {
+    if area.is_nan() || area <= 0.0 {
         return;
     }
     let radius = corners(&shape)
