@@ -116,11 +116,7 @@ pub fn gather(links: &Links, b: &[Vec3A], out: &mut [Rgb]) {
         .for_each(|(c, chunk)| {
             for (k, e) in chunk.iter_mut().enumerate() {
                 let i = c * CHUNK + k;
-                let mut sum = Vec3A::ZERO;
-                for link in links.of(i) {
-                    sum += b[link.source as usize] * link.factor;
-                }
-                *e = sum.into();
+                *e = links.gather(i, b).into();
             }
         });
 }

@@ -223,7 +223,7 @@ impl Radiosity {
             patches: n,
             dropped,
             clusters: r.hierarchy.clusters.len(),
-            links: r.links.links.len(),
+            links: r.links.len(),
             links_patch_to_patch: r.links.patch_to_patch,
             bytes: r.bytes(),
             cut,
