@@ -364,8 +364,11 @@ fn info(path: &Path) -> Result<(), String> {
     println!("geometry: {prims} bounded primitives, {planes} planes");
     println!("materials: {}", scene.materials.len() - 1);
     println!("lights: {}", scene.lights.len());
-    for light in &scene.lights {
+    for (light, path) in scene.lights.iter().zip(&scene.light_paths) {
         println!("  {light:?}");
+        if let Some(path) = path {
+            println!("    moves along {} keyframes", path.keys().len());
+        }
     }
     match &scene.medium {
         Some(m) => println!("medium: {m:?}"),
