@@ -158,6 +158,24 @@ fn radiosity_image_is_the_direct_image_plus_indirect_light() {
 }
 
 #[test]
+fn the_moving_lights_room_renders_a_frame() {
+    // Relit at mid-animation with no recompile; the frame is finite, and
+    // the bounce light adds to what the lights reach directly.
+    let mut scene = from_toml_str(ROOM, None).unwrap();
+    scene.settings.patch_size = Some(0.5);
+    scene.settings.width = 24;
+    scene.settings.height = 16;
+    scene.settings.spp = 1;
+    let mut integrator = RadiosityIntegrator::new(&scene);
+    scene.lights = scene.lights_at(0.5);
+    integrator.solution.update(&scene);
+    let image = render_with(&scene, &integrator, &RenderObserver::none());
+    let direct = render_with(&scene, &Direct, &RenderObserver::none());
+    assert!(image.pixels.iter().all(|p| p.is_finite()));
+    assert!(image.mean().element_sum() > 1.1 * direct.mean().element_sum());
+}
+
+#[test]
 fn keyframes_move_lights_linearly() {
     let scene = from_toml_str(ROOM, None).unwrap();
     assert!(scene.is_animated());

@@ -14,7 +14,7 @@ use std::f32::consts::FRAC_1_PI;
 ///
 ///   L = L_direct + ρ(p)/π · E_ind(p),
 ///
-/// where L_direct is [`surface_radiance`] (emission plus direct light with
+/// where L_direct is `surface_radiance` (emission plus direct light with
 /// shadow rays, per pixel sample), ρ(p) the diffuse albedo at the pixel's
 /// point (so a checker stays sharp) and E_ind the indirect irradiance
 /// interpolated between patch centres on the side facing the camera. In a

@@ -9,25 +9,31 @@
 //! fraction of the light leaving a small area at i that reaches j, and, by
 //! reciprocity, the irradiance at i from j per unit radiosity of j:
 //! E_i = Σ_j F_ij B_j. It holds when r is large beside the patches; for
-//! patches closer than [`NEAR`] × (sum of their radii), F_ij is the exact
-//! point-to-polygon factor ([`point_polygon_factor`]) averaged over 4×4
-//! equal-area points of i instead. Visibility
-//! multiplies it: one ray between the centres for distant pairs, the fraction
-//! of 4 unblocked rays between points of both patches for near ones. Both use
-//! the same segments from either end, so A_i F_ij = A_j F_ji holds for
-//! what the rays see too.
+//! patches closer than [`NEAR`] × (sum of their radii), [`form_factor`]
+//! uses the exact point-to-polygon factor ([`point_polygon_factor`])
+//! averaged over 6×6 equal-area points, symmetrised over both directions.
+//! Visibility multiplies it: one ray between the centres for distant pairs,
+//! the fraction of [`NEAR_RAYS`] unblocked rays between points of both
+//! patches for near ones; both directions test the same segments, so
+//! A_i F_ij = A_j F_ji holds for what the rays see too.
 //!
 //! Links follow Hanrahan, Salzman and Aupperle, "A Rapid Hierarchical
-//! Radiosity Algorithm" (SIGGRAPH 1991), with patches gathering from
-//! clusters as in the seed: each patch walks the hierarchy from the root;
-//! a node wholly behind the patch is skipped; a cluster j far enough —
-//! the patch lies outside twice its bounding radius and its estimated form
-//! factor A_j / (π d²) (d: distance to its centre) is below the link
-//! threshold — becomes one link; otherwise its children are visited, down to
-//! single patches. A cluster link's factor is the Monte Carlo estimate
-//! A_j · (1/M) Σ_m cos φi cos φk V / (π r²) over M = 4 of its patches k
-//! chosen with probability ∝ area (stratified), an unbiased estimate of
-//! Σ_k F_ik over the cluster's patches (each taken at its centre).
+//! Radiosity Algorithm" (SIGGRAPH 1991), with clusters (the seed's k-means
+//! hierarchy) as sources: refinement starts from (root, root); a pair where
+//! one side lies wholly behind the other is dropped (`behind`); two
+//! patches are linked by their form factor; otherwise the pair is linked as
+//! it stands when both ends are acceptable, and else the end that is not
+//! (the larger, if neither is) is replaced by its children. A source
+//! cluster is acceptable when the receiver lies outside twice the sum of
+//! their bounding radii and its estimated form factor A_j/(π d²) (d between
+//! centres) is below the link threshold; a receiver is acceptable when it
+//! is a patch or, with `receiver_share` > 0, a flat cluster passing the
+//! same test with threshold × receiver_share (its irradiance is then handed
+//! down to its patches). A link with a cluster at either end has the Monte
+//! Carlo factor A_s · (1/M) Σ_m cos φ cos φ' V / (π r²) over M =
+//! [`CLUSTER_SAMPLES`] pairs of patch centres drawn ∝ area from both ends
+//! (stratified): an unbiased estimate of the area-weighted mean, over the
+//! receiver's patches, of Σ_k F_ik over the source's patches.
 
 use super::hierarchy::{Hierarchy, mix};
 use super::patches::Patch;
@@ -37,7 +43,7 @@ use rayon::prelude::*;
 use std::f32::consts::PI;
 
 /// Pairs closer than NEAR × (radius_i + radius_j) are integrated over
-/// points of both patches.
+/// points of the patches instead of taken at their centres.
 pub const NEAR: f32 = 2.0;
 /// Patches a cluster link's factor is estimated from.
 pub const CLUSTER_SAMPLES: usize = 8;
@@ -117,7 +123,7 @@ impl Links {
         })
     }
 
-    /// Σ F · b[source] over node `receiver`'s links: the gather's inner loop.
+    /// Σ F · b(source) over node `receiver`'s links: the gather's inner loop.
     #[inline]
     pub fn gather(&self, receiver: usize, b: &[glam::Vec3A]) -> glam::Vec3A {
         let range = self.offsets[receiver] as usize..self.offsets[receiver + 1] as usize;
