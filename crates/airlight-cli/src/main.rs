@@ -270,7 +270,8 @@ fn gi(args: GiArgs) -> Result<(), String> {
         .map_err(|e| format!("cannot start worker threads: {e}"))?;
     pool.install(|| {
         let params = CompileParams::for_scene(&scene);
-        let solution = Radiosity::compile_with(&scene, params);
+        let solution = Radiosity::compile_with(&scene, params)
+            .map_err(|e| format!("{}: {e}", args.scene.display()))?;
         let st = solution.stats();
         let ms = |d: std::time::Duration| d.as_secs_f64() * 1e3;
         println!("scene: {}", args.scene.display());

@@ -92,7 +92,7 @@ fn cornell_box_one_bounce_matches_monte_carlo() {
     // from radiosity within 5% of the Monte Carlo estimate (whose own
     // standard error here is about 1%).
     let scene = cornell(0.2);
-    let r = Radiosity::compile(&scene);
+    let r = Radiosity::compile(&scene).unwrap();
     let middle = Vec3::new(2.78, 2.74, 2.8);
     for (object, (shape, material)) in scene.objects.iter().enumerate().take(5) {
         let Shape::Quad {
@@ -133,7 +133,7 @@ fn radiosity_image_is_the_direct_image_plus_indirect_light() {
     scene.settings.width = 32;
     scene.settings.height = 32;
     scene.settings.spp = 2;
-    let radiosity = RadiosityIntegrator::new(&scene);
+    let radiosity = RadiosityIntegrator::new(&scene).unwrap();
     let a = render_with(&scene, &radiosity, &RenderObserver::none());
     let b = render_with(&scene, &Direct, &RenderObserver::none());
     for (x, y) in a.pixels.iter().zip(&b.pixels) {
@@ -166,7 +166,7 @@ fn the_moving_lights_room_renders_a_frame() {
     scene.settings.width = 24;
     scene.settings.height = 16;
     scene.settings.spp = 1;
-    let mut integrator = RadiosityIntegrator::new(&scene);
+    let mut integrator = RadiosityIntegrator::new(&scene).unwrap();
     scene.lights = scene.lights_at(0.5);
     integrator.solution.update(&scene);
     let image = render_with(&scene, &integrator, &RenderObserver::none());

@@ -94,7 +94,9 @@ pub fn for_scene(scene: &Scene) -> Result<Box<dyn Integrator>, String> {
             steps: s.steps,
             jitter: s.jitter,
         })),
-        IntegratorKind::Radiosity => Ok(Box::new(RadiosityIntegrator::new(scene))),
+        IntegratorKind::Radiosity => Ok(Box::new(
+            RadiosityIntegrator::new(scene).map_err(|e| e.to_string())?,
+        )),
         other => Err(format!(
             "the `{other}` integrator is not implemented yet; available: direct, raymarch, radiosity"
         )),

@@ -5,7 +5,7 @@ use super::raymarch::in_scattered;
 use super::{Integrator, surface_radiance};
 use crate::Rgb;
 use crate::geometry::Ray;
-use crate::radiosity::Radiosity;
+use crate::radiosity::{Radiosity, RadiosityError};
 use crate::sampling::Sampler;
 use crate::scene::Scene;
 use std::f32::consts::FRAC_1_PI;
@@ -32,12 +32,12 @@ pub struct RadiosityIntegrator {
 
 impl RadiosityIntegrator {
     /// Compiles and lights `scene` with its own settings.
-    pub fn new(scene: &Scene) -> Self {
-        RadiosityIntegrator {
-            solution: Radiosity::compile(scene),
+    pub fn new(scene: &Scene) -> Result<Self, RadiosityError> {
+        Ok(RadiosityIntegrator {
+            solution: Radiosity::compile(scene)?,
             steps: scene.settings.steps,
             jitter: scene.settings.jitter,
-        }
+        })
     }
 }
 

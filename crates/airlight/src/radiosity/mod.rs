@@ -45,6 +45,20 @@ use patches::Patch;
 use rayon::prelude::*;
 use std::time::{Duration, Instant};
 
+/// Most patches a scene may be cut into (about 2 GB of links at the
+/// default threshold; see docs/radiosity-bench.md).
+pub const MAX_PATCHES: usize = 2_000_000;
+
+/// Why a scene cannot be compiled.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum RadiosityError {
+    #[error(
+        "render.patch_size = {patch_size} would cut the scene into about {estimated} patches; \
+         at most {MAX_PATCHES} are allowed: choose a larger patch_size"
+    )]
+    TooManyPatches { patch_size: f32, estimated: f64 },
+}
+
 /// What compilation needs beyond the scene.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct CompileParams {
@@ -147,18 +161,30 @@ pub struct Radiosity {
 impl Radiosity {
     /// Compiles `scene` with the settings of its `[render]` table, then
     /// lights it with its lights ([`Radiosity::update`]).
-    pub fn compile(scene: &Scene) -> Radiosity {
-        let mut r = Radiosity::compile_with(scene, CompileParams::for_scene(scene));
+    pub fn compile(scene: &Scene) -> Result<Radiosity, RadiosityError> {
+        let mut r = Radiosity::compile_with(scene, CompileParams::for_scene(scene))?;
         r.update(scene);
-        r
+        Ok(r)
     }
 
     /// Compiles `scene` (cut, cull, cluster, link); the lighting is zero
-    /// until [`Radiosity::update`].
-    pub fn compile_with(scene: &Scene, params: CompileParams) -> Radiosity {
+    /// until [`Radiosity::update`]. Fails, before cutting, when the patch
+    /// size would make more than [`MAX_PATCHES`] patches.
+    pub fn compile_with(scene: &Scene, params: CompileParams) -> Result<Radiosity, RadiosityError> {
         let start = Instant::now();
         let mut patches = Vec::new();
         let square = (scene.bounds_center, scene.bounds_radius);
+        let estimated: f64 = scene
+            .objects
+            .iter()
+            .map(|(shape, _)| patches::count(shape, params.patch_size, square))
+            .sum();
+        if estimated.is_nan() || estimated > MAX_PATCHES as f64 {
+            return Err(RadiosityError::TooManyPatches {
+                patch_size: params.patch_size,
+                estimated,
+            });
+        }
         for (index, (shape, material)) in scene.objects.iter().enumerate() {
             patches::cut(
                 shape,
@@ -232,7 +258,7 @@ impl Radiosity {
             link,
             total: start.elapsed(),
         };
-        r
+        Ok(r)
     }
 
     fn bytes(&self) -> usize {

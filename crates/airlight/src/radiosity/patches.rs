@@ -150,6 +150,52 @@ pub fn cut(
     }
 }
 
+/// How many patches [`cut`] makes of `shape` (without making them), so
+/// that a patch size far too small for the scene is refused before memory
+/// runs out.
+pub fn count(shape: &Shape, h: f32, (center, half): (Vec3, f32)) -> f64 {
+    let quad = |u: Vec3, v: Vec3| cells(u.length(), h) as f64 * cells(v.length(), h) as f64;
+    match shape {
+        Shape::Quad { edge_u, edge_v, .. } => 2.0 * quad(*edge_u, *edge_v),
+        Shape::Plane { point, normal } => {
+            let (_, u, v) = plane_square(*point, *normal, center, half);
+            2.0 * quad(u, v)
+        }
+        Shape::Box { min, max } => {
+            let d = *max - *min;
+            let (x, y, z) = (Vec3::X * d.x, Vec3::Y * d.y, Vec3::Z * d.z);
+            2.0 * (quad(x, y) + quad(y, z) + quad(x, z))
+        }
+        Shape::Sphere { radius, .. } => {
+            let bands = cells(PI * radius, h).max(2) as f64;
+            bands * (cells(2.0 * PI * radius, h).max(3) as f64)
+        }
+        Shape::Mesh {
+            positions,
+            triangles,
+        } => triangles
+            .iter()
+            .map(|t| {
+                let [a, b, c] = t.map(|i| positions[i as usize]);
+                let longest = (b - a).length().max((c - a).length()).max((c - b).length());
+                2.0 * (cells(longest, h).min(256) as f64).powi(2)
+            })
+            .sum(),
+        Shape::Transformed {
+            shape,
+            world_from_local,
+        } => {
+            let linear = Mat3::from(world_from_local.matrix3);
+            let stretch = linear
+                .x_axis
+                .length()
+                .max(linear.y_axis.length())
+                .max(linear.z_axis.length());
+            count(shape, h / stretch, (center, half))
+        }
+    }
+}
+
 /// The square an infinite plane is clipped to: centred on the projection of
 /// `center` onto the plane, with half side `half`; returns (corner, u, v)
 /// with u × v along `normal`.

@@ -30,6 +30,7 @@ fn compile(scene: &Scene, patch_size: f32, threshold: f32) -> Radiosity {
             seed: 1,
         },
     )
+    .unwrap()
 }
 
 /// F from object `from` (its side facing `toward`) to object `to`:
@@ -239,7 +240,7 @@ fn receiver_clusters_keep_energy() {
         receiver_share: 0.5,
         ..CompileParams::for_scene(&scene)
     };
-    let mut with = Radiosity::compile_with(&scene, params);
+    let mut with = Radiosity::compile_with(&scene, params).unwrap();
     with.update(&scene);
     let mut without = compile(&scene, 0.3, DEFAULT_THRESHOLD);
     without.update(&scene);
@@ -299,7 +300,7 @@ fn shading_is_continuous_across_patches() {
     // proportion); a jump at a patch edge would not shrink at all. Nearest-
     // patch lookup fails this.
     let scene = cornell(0.3);
-    let r = Radiosity::compile(&scene);
+    let r = Radiosity::compile(&scene).unwrap();
     let h = r.params().patch_size;
     let coarse = largest_step(&r, h / 10.0);
     let fine = largest_step(&r, h / 80.0);
@@ -311,7 +312,7 @@ fn a_moved_light_needs_no_recompile() {
     // Updating with moved lights gives what compiling anew with those lights
     // gives; so does a changed albedo.
     let mut scene = cornell(0.4);
-    let mut r = Radiosity::compile(&scene);
+    let mut r = Radiosity::compile(&scene).unwrap();
     let before = r.indirect_irradiance().to_vec();
     let moved: Vec<Light> = scene
         .lights
@@ -323,7 +324,7 @@ fn a_moved_light_needs_no_recompile() {
     scene.lights = moved;
     scene.materials[0] = Material::diffuse(Rgb::new(0.2, 0.9, 0.3));
     r.update(&scene);
-    let fresh = Radiosity::compile(&scene);
+    let fresh = Radiosity::compile(&scene).unwrap();
     assert_eq!(r.indirect_irradiance(), fresh.indirect_irradiance());
 }
 
@@ -341,4 +342,20 @@ fn bfloat16_factors_round_to_nearest() {
         mean_error += rel as f64 / 10_000.0;
     }
     assert!(mean_error.abs() < 1e-4, "biased: {mean_error}");
+}
+
+#[test]
+fn too_small_a_patch_size_is_refused_before_cutting() {
+    let scene = cornell(1e-4);
+    let e = Radiosity::compile(&scene).unwrap_err();
+    assert!(e.to_string().contains("choose a larger patch_size"), "{e}");
+    // The count matches what cutting makes, before the sides are culled.
+    let r = compile(&cornell(0.3), 0.3, DEFAULT_THRESHOLD);
+    let square = (scene.bounds_center, scene.bounds_radius);
+    let counted: f64 = scene
+        .objects
+        .iter()
+        .map(|(s, _)| patches::count(s, 0.3, square))
+        .sum();
+    assert_eq!(counted as usize, r.stats().patches + r.stats().dropped);
 }
