@@ -27,6 +27,7 @@
 //! direct light. The diffuse albedo of a Phong material bounces; its specular
 //! lobe does not.
 
+pub mod factors;
 pub mod hierarchy;
 pub mod lighting;
 pub mod links;

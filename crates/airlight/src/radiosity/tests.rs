@@ -141,12 +141,14 @@ fn form_factors_are_reciprocal() {
         if i == j {
             continue;
         }
-        let fij = links::form_factor(&p[i], &p[j]) * links::visibility(&scene.geometry, p, i, j, 3);
-        let fji = links::form_factor(&p[j], &p[i]) * links::visibility(&scene.geometry, p, j, i, 3);
+        let fij =
+            factors::form_factor(&p[i], &p[j]) * factors::visibility(&scene.geometry, p, i, j, 3);
+        let fji =
+            factors::form_factor(&p[j], &p[i]) * factors::visibility(&scene.geometry, p, j, i, 3);
         let (a, b) = (p[i].area * fij, p[j].area * fji);
         // Far pairs use the symmetric point formula; near ones integrate
         // over the receiver only, to within the quadrature's error.
-        let tol = if links::is_near(&p[i], &p[j]) {
+        let tol = if factors::is_near(&p[i], &p[j]) {
             0.02
         } else {
             1e-4
