@@ -31,6 +31,11 @@ enum Command {
     /// Plot the attenuation curves of a light of given radius, intensity and
     /// cutoff as a PNG, and print where each reaches zero (d_max).
     Attenuation(AttenuationArgs),
+    /// Radiosity in real time: compile the scene once, then relight it for
+    /// each frame with its lights moved along their keyframes; prints the
+    /// compile figures and per-frame milliseconds (median, p95) of
+    /// direct + push + gather.
+    Gi(GiArgs),
     /// Compare two EXR images: prints rmse, rel_mse, mae and max.
     Compare {
         image: PathBuf,
@@ -49,7 +54,7 @@ struct RenderArgs {
     /// Default: airlight.png for the demo, else the scene's name with .png.
     #[arg(short, long = "output", value_name = "OUT")]
     output: Vec<PathBuf>,
-    /// Integrator: direct, raymarch (analytic, stochastic, path, radiosity are planned).
+    /// Integrator: direct, raymarch, radiosity (analytic, stochastic, path are planned).
     #[arg(long)]
     integrator: Option<IntegratorKind>,
     /// Samples per pixel.
@@ -95,6 +100,38 @@ struct AttenuationArgs {
     output: PathBuf,
 }
 
+#[derive(clap::Args)]
+struct GiArgs {
+    /// Scene file (TOML).
+    scene: PathBuf,
+    /// Frames; frame k is at time k/(frames − 1) of the animation.
+    #[arg(long, default_value_t = 60, value_parser = clap::value_parser!(u32).range(1..))]
+    frames: u32,
+    /// Write every frame, rendered with the radiosity integrator, as
+    /// DIR/frame_0000.png, … (not timed).
+    #[arg(long, value_name = "DIR")]
+    output_dir: Option<PathBuf>,
+    /// Patch size (overrides the scene's render.patch_size).
+    #[arg(long)]
+    patch_size: Option<f32>,
+    /// Bounces (overrides render.bounces).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
+    bounces: Option<u32>,
+    /// Link threshold (overrides render.link_threshold).
+    #[arg(long)]
+    link_threshold: Option<f32>,
+    /// Samples per pixel of written frames.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
+    spp: Option<u32>,
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
+    width: Option<u32>,
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
+    height: Option<u32>,
+    /// Worker threads (default: all cores).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
+    threads: Option<u32>,
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
@@ -102,6 +139,7 @@ fn main() -> ExitCode {
         Command::Info { scene } => info(&scene),
         Command::Compare { image, reference, map } => compare(&image, &reference, map.as_deref()),
         Command::Attenuation(args) => attenuation(args),
+        Command::Gi(args) => gi(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -197,6 +235,109 @@ fn render(args: RenderArgs) -> Result<(), String> {
     Ok(())
 }
 
+fn gi(args: GiArgs) -> Result<(), String> {
+    use airlight::integrator::RadiosityIntegrator;
+    use airlight::radiosity::{CompileParams, Radiosity};
+    let mut scene = load(Some(&args.scene))?;
+    let s = &mut scene.settings;
+    if let Some(v) = args.patch_size {
+        if !(v.is_finite() && v > 0.0) {
+            return Err(format!("--patch-size must be a positive number, got {v}"));
+        }
+        s.patch_size = Some(v);
+    }
+    if let Some(v) = args.link_threshold {
+        if !(v.is_finite() && v >= 0.0) {
+            return Err(format!("--link-threshold must be a number ≥ 0, got {v}"));
+        }
+        s.link_threshold = v;
+    }
+    if let Some(v) = args.bounces {
+        s.bounces = v;
+    }
+    if let Some(v) = args.spp {
+        s.spp = v;
+    }
+    if let Some(v) = args.width {
+        s.width = v;
+    }
+    if let Some(v) = args.height {
+        s.height = v;
+    }
+    if let Some(dir) = &args.output_dir {
+        std::fs::create_dir_all(dir).map_err(|e| format!("cannot create `{}`: {e}", dir.display()))?;
+    }
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(args.threads.unwrap_or(0) as usize)
+        .build()
+        .map_err(|e| format!("cannot start worker threads: {e}"))?;
+    pool.install(|| {
+        let params = CompileParams::for_scene(&scene);
+        let solution = Radiosity::compile_with(&scene, params).map_err(|e| format!("{}: {e}", args.scene.display()))?;
+        let st = solution.stats();
+        let ms = |d: std::time::Duration| d.as_secs_f64() * 1e3;
+        println!("scene: {}", args.scene.display());
+        println!(
+            "threads: {}, patch_size: {}, link_threshold: {}, bounces: {}",
+            rayon::current_num_threads(),
+            params.patch_size,
+            params.link_threshold,
+            scene.settings.bounces
+        );
+        println!("patches: {} ({} sides that see nothing dropped), clusters: {}", st.patches, st.dropped, st.clusters);
+        println!(
+            "links: {} ({} patch to patch, {} with a cluster; {:.1} per patch)",
+            st.links,
+            st.links_patch_to_patch,
+            st.links - st.links_patch_to_patch,
+            st.links as f64 / st.patches.max(1) as f64
+        );
+        println!("memory: {:.2} MiB", st.bytes as f64 / (1u64 << 20) as f64);
+        println!(
+            "compile: {:.1} ms (cut {:.1}, cull {:.1}, cluster {:.1}, link {:.1})",
+            ms(st.total),
+            ms(st.cut),
+            ms(st.cull),
+            ms(st.cluster),
+            ms(st.link)
+        );
+        let mut integrator =
+            RadiosityIntegrator { solution, steps: scene.settings.steps, jitter: scene.settings.jitter };
+        let bounces = scene.settings.bounces;
+        let mut frames = Vec::with_capacity(args.frames as usize);
+        for k in 0..args.frames {
+            let time = if args.frames > 1 { k as f32 / (args.frames - 1) as f32 } else { 0.0 };
+            let lights = scene.lights_at(time);
+            let times = integrator.solution.update_with(&scene, &lights, bounces);
+            frames.push(times);
+            if let Some(dir) = &args.output_dir {
+                scene.lights = lights;
+                let image = render_with(&scene, &integrator, &RenderObserver::none());
+                let out = dir.join(format!("frame_{k:04}.png"));
+                image
+                    .write(&out, scene.settings.exposure, scene.settings.tonemap)
+                    .map_err(|e| format!("cannot write `{}`: {e}", out.display()))?;
+            }
+        }
+        let stat = |f: &dyn Fn(&airlight::radiosity::FrameTimes) -> std::time::Duration| {
+            let mut v: Vec<f64> = frames.iter().map(|t| ms(f(t))).collect();
+            v.sort_by(f64::total_cmp);
+            let at = |q: f64| v[((v.len() - 1) as f64 * q).round() as usize];
+            (at(0.5), at(0.95))
+        };
+        let (med, p95) = stat(&|t| t.total());
+        println!("per frame (direct + push + gather), {} frames: median {med:.3} ms, p95 {p95:.3} ms", frames.len());
+        let (d, _) = stat(&|t| t.direct);
+        let (p, _) = stat(&|t| t.push);
+        let (g, _) = stat(&|t| t.gather);
+        println!("  median direct {d:.3} ms, push {p:.3} ms, gather {g:.3} ms");
+        if let Some(dir) = &args.output_dir {
+            println!("frames written to {}", dir.display());
+        }
+        Ok(())
+    })
+}
+
 fn info(path: &Path) -> Result<(), String> {
     let scene = load(Some(path))?;
     let s = &scene.settings;
@@ -210,8 +351,11 @@ fn info(path: &Path) -> Result<(), String> {
     println!("geometry: {prims} bounded primitives, {planes} planes");
     println!("materials: {}", scene.materials.len() - 1);
     println!("lights: {}", scene.lights.len());
-    for light in &scene.lights {
+    for (light, path) in scene.lights.iter().zip(&scene.light_paths) {
         println!("  {light:?}");
+        if let Some(path) = path {
+            println!("    moves along {} keyframes", path.keys().len());
+        }
     }
     match &scene.medium {
         Some(m) => println!("medium: {m:?}"),

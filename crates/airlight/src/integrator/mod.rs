@@ -3,11 +3,13 @@
 
 mod direct;
 pub mod path;
+mod radiosity;
 mod raymarch;
 
 pub use direct::Direct;
 pub use path::PathTracer;
-pub use raymarch::Raymarch;
+pub use radiosity::RadiosityIntegrator;
+pub use raymarch::{Raymarch, in_scattered};
 
 use crate::Rgb;
 use crate::geometry::{Ray, SurfaceHit, offset_origin};
@@ -86,7 +88,10 @@ pub fn for_scene(scene: &Scene) -> Result<Box<dyn Integrator>, String> {
         IntegratorKind::Direct => Ok(Box::new(Direct)),
         IntegratorKind::Raymarch => Ok(Box::new(Raymarch { steps: s.steps, jitter: s.jitter })),
         IntegratorKind::Path => Ok(Box::new(PathTracer { max_depth: s.max_depth })),
-        other => Err(format!("the `{other}` integrator is not implemented yet; available: direct, raymarch, path")),
+        IntegratorKind::Radiosity => Ok(Box::new(RadiosityIntegrator::new(scene).map_err(|e| e.to_string())?)),
+        other => Err(format!(
+            "the `{other}` integrator is not implemented yet; available: direct, raymarch, path, radiosity"
+        )),
     }
 }
 

@@ -2,12 +2,14 @@
 //! distant `irradiance` on a facing surface, sphere and quad `radiance`.
 
 mod attenuation;
+mod keyframes;
 mod spot;
 
 pub use attenuation::{
     Attenuation, AttenuationModel, cutoff_falloff, cutoff_range, sphere_falloff, window_rational, window_tan,
     window_ue4,
 };
+pub use keyframes::Keyframes;
 pub use spot::{SpotProfile, spot_falloff};
 
 use crate::Rgb;

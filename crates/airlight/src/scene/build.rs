@@ -7,7 +7,7 @@ use crate::Rgb;
 use crate::camera::{Camera, Projection};
 use crate::geometry::Shape;
 use crate::integrator::IntegratorKind;
-use crate::light::{Attenuation, Light, SpotProfile};
+use crate::light::{Attenuation, Keyframes, Light, SpotProfile};
 use crate::material::Material;
 use crate::medium::Medium;
 use glam::{Affine3A, Quat, Vec3};
@@ -93,7 +93,11 @@ impl Checker<'_> {
             builder = builder.object(shape, &material);
         }
         for (i, light) in desc.lights.iter().enumerate() {
-            builder = builder.light(self.light(i, light)?);
+            let built = self.light(i, light)?;
+            builder = match self.keyframes(i, light, &built)? {
+                Some(path) => builder.moving_light(built, path),
+                None => builder.light(built),
+            };
         }
         builder.build()
     }
@@ -145,6 +149,13 @@ impl Checker<'_> {
         }
         if let Some(f) = r.filter {
             s.filter = f;
+        }
+        if let Some(p) = &r.patch_size {
+            s.patch_size = Some(self.positive(p.span(), "render.patch_size", *p.get_ref())?);
+        }
+        s.bounces = count(&r.bounces, "bounces", 1, s.bounces)?;
+        if let Some(t) = &r.link_threshold {
+            s.link_threshold = self.positive(t.span(), "render.link_threshold", *t.get_ref())?;
         }
         Ok(s)
     }
@@ -597,6 +608,42 @@ impl Checker<'_> {
         let attenuation = Attenuation::new(model, radius, e0, cutoff, range)
             .map_err(|why| self.err_field(span.clone(), "attenuation", format!("{label}: {why}")))?;
         Ok(light.with_attenuation(attenuation))
+    }
+}
+
+impl Checker<'_> {
+    /// A light's `keyframes`: times in [0, 1], strictly increasing, finite
+    /// positions; not on a distant light.
+    fn keyframes(&self, index: usize, desc: &Spanned<LightDesc>, light: &Light) -> Result<Option<Keyframes>> {
+        let Some(keys) = &desc.get_ref().keyframes else {
+            return Ok(None);
+        };
+        let label = format!("lights[{index}].keyframes");
+        if light.position().is_none() {
+            return Err(self.err(keys.span(), format!("{label}: a distant light has no position to move")));
+        }
+        if keys.get_ref().is_empty() {
+            return Err(self.err(keys.span(), format!("{label} needs at least one {{ time, position }} key")));
+        }
+        let mut out = Vec::with_capacity(keys.get_ref().len());
+        for (k, key) in keys.get_ref().iter().enumerate() {
+            let KeyframeDesc { time, position } = key.get_ref();
+            if !(0.0..=1.0).contains(time) {
+                return Err(self.err(key.span(), format!("{label}[{k}].time must lie in [0, 1], got {time}")));
+            }
+            let previous = out.last().map(|&(t, _): &(f32, Vec3)| t);
+            if let Some(previous) = previous.filter(|&p| *time <= p) {
+                return Err(self.err(
+                    key.span(),
+                    format!("{label}[{k}].time must be greater than the previous key's ({previous}), got {time}"),
+                ));
+            }
+            if !position.0.is_finite() {
+                return Err(self.err(key.span(), format!("{label}[{k}].position must be finite, got {}", position.0)));
+            }
+            out.push((*time, position.0));
+        }
+        Ok(Keyframes::new(out))
     }
 }
 

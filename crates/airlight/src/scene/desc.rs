@@ -45,6 +45,14 @@ pub struct RenderDesc {
     pub jitter: Option<bool>,
     pub cull_lights: Option<bool>,
     pub filter: Option<crate::scene::PixelFilter>,
+    /// Radiosity: patch side length in world units (default: 1/32 of the
+    /// largest extent of the bounded geometry).
+    pub patch_size: Option<Spanned<f32>>,
+    /// Radiosity: bounces of indirect light (default 1).
+    pub bounces: Option<Spanned<i64>>,
+    /// Radiosity: largest estimated form factor A/(π d²) of a cluster that a
+    /// patch links to as a whole (default 0.02).
+    pub link_threshold: Option<Spanned<f32>>,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
@@ -192,6 +200,17 @@ pub struct LightDesc {
     pub cutoff: Option<f32>,
     /// d_max: how far from its surface a finite-range falloff reaches.
     pub range: Option<f32>,
+    /// The path the light moves along in animations; see
+    /// [`crate::light::Keyframes`].
+    pub keyframes: Option<Spanned<Vec<Spanned<KeyframeDesc>>>>,
+}
+
+/// One key of a moving light: `{ time = 0.0, position = [x, y, z] }`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct KeyframeDesc {
+    pub time: f32,
+    pub position: Point,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]

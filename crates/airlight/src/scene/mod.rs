@@ -15,7 +15,7 @@ use crate::Rgb;
 use crate::camera::Camera;
 use crate::geometry::{Geometry, GeometryBuilder, Shape};
 use crate::integrator::IntegratorKind;
-use crate::light::Light;
+use crate::light::{Keyframes, Light};
 use crate::material::Material;
 use crate::medium::Medium;
 use glam::{Affine3A, Vec3};
@@ -54,6 +54,15 @@ pub struct RenderSettings {
     pub tonemap: Tonemap,
     /// Offset march samples by a random fraction of a step per pixel sample.
     pub jitter: bool,
+    /// Radiosity: the side length (world units) surfaces are cut into
+    /// patches of; None picks 1/32 of the largest extent of the bounded
+    /// geometry (see `radiosity::CompileParams`).
+    pub patch_size: Option<f32>,
+    /// Radiosity: bounces of indirect light (1 = one bounce, as the seed).
+    pub bounces: u32,
+    /// Radiosity: a patch links to a whole cluster instead of its children
+    /// when the cluster's estimated form factor A_j/(π d²) is below this.
+    pub link_threshold: f32,
     /// Skip lights whose range ends before a point (finite-range falloffs).
     pub cull_lights: bool,
     /// How a pixel gathers its samples.
@@ -89,9 +98,15 @@ impl Default for RenderSettings {
             jitter: true,
             cull_lights: true,
             filter: PixelFilter::Box,
+            patch_size: None,
+            bounces: 1,
+            link_threshold: DEFAULT_LINK_THRESHOLD,
         }
     }
 }
+
+/// Default of [`RenderSettings::link_threshold`].
+pub const DEFAULT_LINK_THRESHOLD: f32 = 0.02;
 
 /// Everything a render needs, built and validated.
 #[derive(Debug)]
@@ -100,8 +115,14 @@ pub struct Scene {
     pub camera: Camera,
     pub materials: Vec<Material>,
     pub lights: Vec<Light>,
+    /// For each light in `lights`, the path it moves along in animations
+    /// (None: it stays put). See [`crate::light::Keyframes`].
+    pub light_paths: Vec<Option<Keyframes>>,
     pub medium: Option<Medium>,
     pub geometry: Geometry,
+    /// The scene's objects (not the lights' surfaces), in world space, with
+    /// their material index: what radiosity cuts into patches.
+    pub objects: Vec<(Shape, u32)>,
     /// Centre and radius of a sphere around the bounded geometry, the lights
     /// and the camera; a sun's light enters the scene from its surface, as in
     /// pbrt-v4 and Mitsuba 3.
@@ -153,6 +174,24 @@ impl Scene {
             Err(_) => visit(&mut Vec::new()),
         });
     }
+
+    /// The lights at `time` in [0, 1] of the animation: each light with
+    /// keyframes moved to its keyframed position, the others as they are.
+    pub fn lights_at(&self, time: f32) -> Vec<Light> {
+        self.lights
+            .iter()
+            .zip(&self.light_paths)
+            .map(|(light, path)| match path {
+                Some(path) => light.moved_to(path.at(time)),
+                None => *light,
+            })
+            .collect()
+    }
+
+    /// Whether any light moves.
+    pub fn is_animated(&self) -> bool {
+        self.light_paths.iter().any(Option::is_some)
+    }
 }
 
 /// Builds a [`Scene`] in Rust, as the seed's World/Camera example does.
@@ -164,6 +203,7 @@ pub struct SceneBuilder {
     material_names: HashMap<String, u32>,
     objects: Vec<(Shape, String)>,
     lights: Vec<Light>,
+    light_paths: Vec<Option<Keyframes>>,
     medium: Option<Medium>,
 }
 
@@ -217,6 +257,14 @@ impl SceneBuilder {
 
     pub fn light(mut self, light: Light) -> Self {
         self.lights.push(light);
+        self.light_paths.push(None);
+        self
+    }
+
+    /// A light that moves along `path` in animations.
+    pub fn moving_light(mut self, light: Light, path: Keyframes) -> Self {
+        self.lights.push(light);
+        self.light_paths.push(Some(path));
         self
     }
 
@@ -227,7 +275,8 @@ impl SceneBuilder {
 
     /// Checks and builds the scene, with its BVH.
     pub fn build(self) -> Result<Scene, SceneError> {
-        let SceneBuilder { settings, camera, mut materials, material_names, objects, lights, medium } = self;
+        let SceneBuilder { settings, camera, mut materials, material_names, objects, lights, light_paths, medium } =
+            self;
         if settings.width == 0 || settings.height == 0 {
             return Err(SceneError::new(format!(
                 "image size must be at least 1×1, got {}×{}",
@@ -241,12 +290,23 @@ impl SceneBuilder {
             return Err(SceneError::new("steps must be at least 1"));
         }
         let camera = camera.unwrap_or_else(default_camera);
+        if settings.bounces == 0 {
+            return Err(SceneError::new("bounces must be at least 1"));
+        }
+        if settings.patch_size.is_some_and(|p| !(p.is_finite() && p > 0.0)) {
+            return Err(SceneError::new("patch_size must be a positive number"));
+        }
+        if !(settings.link_threshold.is_finite() && settings.link_threshold > 0.0) {
+            return Err(SceneError::new("link_threshold must be a positive number"));
+        }
         let mut geometry = GeometryBuilder::default();
-        for (shape, name) in &objects {
-            let Some(&material) = material_names.get(name) else {
+        let mut placed = Vec::with_capacity(objects.len());
+        for (shape, name) in objects {
+            let Some(&material) = material_names.get(&name) else {
                 return Err(SceneError::new(format!("unknown material `{name}`")));
             };
-            geometry.add(shape, material, None);
+            geometry.add(&shape, material, None);
+            placed.push((shape, material));
         }
         // Area lights are surfaces too: the camera sees them, and they cast
         // shadows. They reflect nothing.
@@ -263,7 +323,19 @@ impl SceneBuilder {
         let geometry = geometry.build();
         let (bounds_center, bounds_radius) = bounding_sphere(&geometry, &lights, &camera);
         let light_culling = LightCulling::new(&lights);
-        Ok(Scene { settings, camera, materials, lights, medium, geometry, bounds_center, bounds_radius, light_culling })
+        Ok(Scene {
+            settings,
+            camera,
+            materials,
+            lights,
+            light_paths,
+            medium,
+            geometry,
+            objects: placed,
+            bounds_center,
+            bounds_radius,
+            light_culling,
+        })
     }
 }
 

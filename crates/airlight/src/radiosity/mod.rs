@@ -1,0 +1,320 @@
+//! Radiosity global illumination with a patch hierarchy, after the seed
+//! (radiosity-gi-and-light-attenuation.txt, first part).
+//!
+//! A static scene is compiled once ([`Radiosity::compile`]): its surfaces are
+//! cut into patches ([`patches`]), the patches clustered into a hierarchy
+//! ([`hierarchy`]), and each patch linked to the patches and clusters it sees
+//! with their form factors ([`links`]). Then every frame
+//! ([`Radiosity::update`]) computes the direct irradiance E⁰ on each patch,
+//! pushes the radiosity B = ρ·E up the hierarchy (area-weighted) and gathers
+//! one bounce over the links:
+//!
+//!   E¹_i = Σ_j F_ij B⁰_j,  B⁰_j = ρ_j E⁰_j,
+//!
+//! the seed's I_i = Σ_j D_j F_ij with D_j = ρ_j E⁰_j. `bounces = N` repeats
+//! push and gather N times (Eᵏ⁺¹_i = Σ_j F_ij ρ_j Eᵏ_j, a Jacobi iteration of
+//! the radiosity equation, Cohen and Wallace 1993 §5), and the indirect
+//! irradiance kept per patch is E¹ + … + E^N. Moving a light, changing its
+//! intensity or a material's albedo needs only `update`, not a recompile.
+//!
+//! Conventions: E is irradiance (W/m²); a Lambertian surface of albedo ρ
+//! reflects radiance L = ρE/π, and its radiosity (exitance) is B = πL = ρE.
+//! The integrator ([`crate::integrator::RadiosityIntegrator`]) evaluates
+//! direct light per pixel and adds the indirect part ρ(p)/π · E_ind(p), with
+//! E_ind interpolated between patch centres ([`lookup`]): the seed's "direct
+//! and indirect illumination at different frequencies". Patches exchange
+//! light in vacuum; a medium attenuates only the camera ray and the per-pixel
+//! direct light. The diffuse albedo of a Phong material bounces; its specular
+//! lobe does not.
+
+pub mod factors;
+pub mod hierarchy;
+pub mod lighting;
+pub mod links;
+pub mod lookup;
+pub mod patches;
+
+use crate::Rgb;
+use crate::light::Light;
+use crate::material::Material;
+use crate::scene::Scene;
+use glam::Vec3;
+use hierarchy::Hierarchy;
+use links::Links;
+use lookup::Lookup;
+use patches::Patch;
+use rayon::prelude::*;
+use std::time::{Duration, Instant};
+
+/// Most patches a scene may be cut into (about 2 GB of links at the
+/// default threshold; see docs/radiosity-bench.md).
+pub const MAX_PATCHES: usize = 2_000_000;
+
+/// Why a scene cannot be compiled.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum RadiosityError {
+    #[error(
+        "render.patch_size = {patch_size} would cut the scene into about {estimated} patches; \
+         at most {MAX_PATCHES} are allowed: choose a larger patch_size"
+    )]
+    TooManyPatches { patch_size: f32, estimated: f64 },
+}
+
+/// What compilation needs beyond the scene.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CompileParams {
+    /// Longest patch edge, world units.
+    pub patch_size: f32,
+    /// A cluster becomes one link when its estimated form factor
+    /// A/(π d²) is below this (and the receiver lies outside twice its
+    /// bounding radius); 0 links every patch to every patch it sees.
+    pub link_threshold: f32,
+    /// Clusters may receive light too (Hanrahan, Salzman and Aupperle's
+    /// two-sided refinement) when flat (normals within ~18°) and their own
+    /// estimated form factor is below `receiver_share × link_threshold`; the
+    /// irradiance a cluster gathers is handed down to its patches. 0 (the
+    /// default) lets only patches receive, as the seed does: on the Cornell
+    /// box receiver clusters saved fewer links than they cost in accuracy.
+    pub receiver_share: f32,
+    /// Seeds the clustering and the sample positions.
+    pub seed: u64,
+}
+
+impl CompileParams {
+    /// The scene's `[render]` settings; without `patch_size`, 1/32 of the
+    /// largest extent of the bounded geometry (1/16 of the scene's bounding
+    /// radius when there are only planes).
+    pub fn for_scene(scene: &Scene) -> Self {
+        let s = &scene.settings;
+        let patch_size = s.patch_size.unwrap_or_else(|| match scene.geometry.bounds() {
+            Some((lo, hi)) if (hi - lo).max_element() > 0.0 => (hi - lo).max_element() / 32.0,
+            _ => scene.bounds_radius / 16.0,
+        });
+        CompileParams { patch_size, link_threshold: s.link_threshold, receiver_share: 0.0, seed: s.seed }
+    }
+}
+
+/// What compilation made and what it cost.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct CompileStats {
+    pub patches: usize,
+    /// Patch sides dropped because nothing lies in front of them (see
+    /// [`patches::faces_anything`]).
+    pub dropped: usize,
+    pub clusters: usize,
+    pub links: usize,
+    /// Links between two single patches (the rest have a cluster at one end
+    /// or both).
+    pub links_patch_to_patch: usize,
+    /// Bytes held by patches, hierarchy, links, lookup grid and per-frame
+    /// buffers.
+    pub bytes: usize,
+    pub cut: Duration,
+    pub cull: Duration,
+    pub cluster: Duration,
+    pub link: Duration,
+    pub total: Duration,
+}
+
+/// Time spent in one [`Radiosity::update`].
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct FrameTimes {
+    pub direct: Duration,
+    pub push: Duration,
+    pub gather: Duration,
+}
+
+impl FrameTimes {
+    pub fn total(&self) -> Duration {
+        self.direct + self.push + self.gather
+    }
+}
+
+/// A compiled scene and its current lighting.
+#[derive(Clone, Debug)]
+pub struct Radiosity {
+    params: CompileParams,
+    patches: Vec<Patch>,
+    hierarchy: Hierarchy,
+    links: Links,
+    lookup: Lookup,
+    stats: CompileStats,
+    /// Per patch: albedo (from the materials last seen), direct irradiance,
+    /// indirect irradiance summed over bounces.
+    albedo: Vec<Rgb>,
+    materials: Vec<Material>,
+    direct: Vec<Rgb>,
+    indirect: Vec<Rgb>,
+    /// Per node (patches, then clusters): radiosity (16-byte aligned for
+    /// the gather's SIMD).
+    node_b: Vec<glam::Vec3A>,
+    /// Per node: one bounce's gathered irradiance.
+    gathered: Vec<Rgb>,
+}
+
+impl Radiosity {
+    /// Compiles `scene` with the settings of its `[render]` table, then
+    /// lights it with its lights ([`Radiosity::update`]).
+    pub fn compile(scene: &Scene) -> Result<Radiosity, RadiosityError> {
+        let mut r = Radiosity::compile_with(scene, CompileParams::for_scene(scene))?;
+        r.update(scene);
+        Ok(r)
+    }
+
+    /// Compiles `scene` (cut, cull, cluster, link); the lighting is zero
+    /// until [`Radiosity::update`]. Fails, before cutting, when the patch
+    /// size would make more than [`MAX_PATCHES`] patches.
+    pub fn compile_with(scene: &Scene, params: CompileParams) -> Result<Radiosity, RadiosityError> {
+        let start = Instant::now();
+        let mut patches = Vec::new();
+        let square = (scene.bounds_center, scene.bounds_radius);
+        let estimated: f64 =
+            scene.objects.iter().map(|(shape, _)| patches::count(shape, params.patch_size, square)).sum();
+        if estimated.is_nan() || estimated > MAX_PATCHES as f64 {
+            return Err(RadiosityError::TooManyPatches { patch_size: params.patch_size, estimated });
+        }
+        for (index, (shape, material)) in scene.objects.iter().enumerate() {
+            patches::cut(shape, *material, index as u32, params.patch_size, square, &mut patches);
+        }
+        let cut = start.elapsed();
+
+        let t = Instant::now();
+        let extents: Vec<patches::Extent> = scene.objects.iter().map(|(shape, _)| patches::Extent::of(shape)).collect();
+        let keep: Vec<bool> = patches.par_iter().map(|p| patches::faces_anything(p, &extents)).collect();
+        let before = patches.len();
+        let mut keep = keep.into_iter();
+        patches.retain(|_| keep.next().unwrap_or(false));
+        let dropped = before - patches.len();
+        let cull = t.elapsed();
+
+        let t = Instant::now();
+        let hierarchy = hierarchy::build(&mut patches, params.seed);
+        let cluster = t.elapsed();
+
+        let t = Instant::now();
+        let links = links::build(
+            &patches,
+            &hierarchy,
+            &scene.geometry,
+            params.link_threshold,
+            params.receiver_share,
+            params.seed,
+        );
+        let link = t.elapsed();
+        let lookup = Lookup::build(&patches, 1.5 * params.patch_size);
+
+        let n = patches.len();
+        let nodes = n + hierarchy.clusters.len();
+        let mut r = Radiosity {
+            params,
+            stats: CompileStats::default(),
+            albedo: vec![Rgb::ZERO; n],
+            materials: Vec::new(),
+            direct: vec![Rgb::ZERO; n],
+            indirect: vec![Rgb::ZERO; n],
+            node_b: vec![glam::Vec3A::ZERO; nodes],
+            gathered: vec![Rgb::ZERO; nodes],
+            patches,
+            hierarchy,
+            links,
+            lookup,
+        };
+        r.stats = CompileStats {
+            patches: n,
+            dropped,
+            clusters: r.hierarchy.clusters.len(),
+            links: r.links.len(),
+            links_patch_to_patch: r.links.patch_to_patch,
+            bytes: r.bytes(),
+            cut,
+            cull,
+            cluster,
+            link,
+            total: start.elapsed(),
+        };
+        Ok(r)
+    }
+
+    fn bytes(&self) -> usize {
+        let per_patch = self.patches.capacity() * size_of::<Patch>()
+            + (self.albedo.capacity() + self.direct.capacity() + self.indirect.capacity() + self.gathered.capacity())
+                * size_of::<Rgb>()
+            + self.node_b.capacity() * size_of::<glam::Vec3A>();
+        per_patch + self.hierarchy.bytes() + self.links.bytes() + self.lookup.bytes()
+    }
+
+    /// Relights with the scene's lights, materials and `bounces`.
+    pub fn update(&mut self, scene: &Scene) -> FrameTimes {
+        self.update_with(scene, &scene.lights, scene.settings.bounces)
+    }
+
+    /// The per-frame step with these `lights` (moved, dimmed: anything but
+    /// the geometry may differ from the scene's) and the scene's materials:
+    /// direct light, then `bounces` × (push, gather).
+    pub fn update_with(&mut self, scene: &Scene, lights: &[Light], bounces: u32) -> FrameTimes {
+        if self.materials != scene.materials {
+            self.materials = scene.materials.clone();
+            for (a, p) in self.albedo.iter_mut().zip(&self.patches) {
+                *a = self.materials[p.material as usize].albedo(p.center, p.normal);
+            }
+        }
+        let mut times = FrameTimes::default();
+        let t = Instant::now();
+        lighting::direct(scene, &self.patches, lights, self.params.seed, &mut self.direct);
+        times.direct = t.elapsed();
+
+        let n = self.patches.len();
+        self.indirect.fill(Rgb::ZERO);
+        for bounce in 0..bounces {
+            let t = Instant::now();
+            let source = if bounce == 0 { &self.direct } else { &self.gathered };
+            for ((b, a), e) in self.node_b[..n].iter_mut().zip(&self.albedo).zip(source) {
+                *b = (*a * *e).into();
+            }
+            lighting::push(&self.patches, &self.hierarchy, &mut self.node_b);
+            times.push += t.elapsed();
+            let t = Instant::now();
+            lighting::gather(&self.links, &self.node_b, &mut self.gathered);
+            lighting::push_down(&self.hierarchy, n, &mut self.gathered);
+            for (e, g) in self.indirect.iter_mut().zip(&self.gathered) {
+                *e += *g;
+            }
+            times.gather += t.elapsed();
+        }
+        times
+    }
+
+    /// The indirect irradiance at `p` on the side with unit normal `n`,
+    /// interpolated smoothly between patch centres ([`lookup`]); None where
+    /// no patch is near (a side dropped as seeing nothing).
+    pub fn irradiance_at(&self, p: Vec3, n: Vec3) -> Option<Rgb> {
+        self.lookup.interpolate(&self.patches, p, n, |i| self.indirect[i])
+    }
+
+    pub fn params(&self) -> CompileParams {
+        self.params
+    }
+    pub fn stats(&self) -> CompileStats {
+        self.stats
+    }
+    pub fn patches(&self) -> &[Patch] {
+        &self.patches
+    }
+    pub fn hierarchy(&self) -> &Hierarchy {
+        &self.hierarchy
+    }
+    pub fn links(&self) -> &Links {
+        &self.links
+    }
+    /// Direct irradiance per patch from the last update.
+    pub fn direct_irradiance(&self) -> &[Rgb] {
+        &self.direct
+    }
+    /// Indirect irradiance per patch (all bounces) from the last update.
+    pub fn indirect_irradiance(&self) -> &[Rgb] {
+        &self.indirect
+    }
+}
+
+#[cfg(test)]
+mod tests;
