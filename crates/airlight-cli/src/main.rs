@@ -2,6 +2,7 @@
 
 use airlight::film::{self, Image};
 use airlight::integrator::IntegratorKind;
+use airlight::integrator::analytic::LightQuadrature;
 use airlight::render::{RenderObserver, render_with};
 use airlight::scene::{self, Scene};
 use clap::{Parser, Subcommand};
@@ -48,7 +49,7 @@ struct RenderArgs {
     /// Default: airlight.png for the demo, else the scene's name with .png.
     #[arg(short, long = "output", value_name = "OUT")]
     output: Vec<PathBuf>,
-    /// Integrator: direct, raymarch (analytic, stochastic, path, radiosity are planned).
+    /// Integrator: direct, raymarch, analytic (stochastic, path, radiosity are planned).
     #[arg(long)]
     integrator: Option<IntegratorKind>,
     /// Samples per pixel.
@@ -63,6 +64,15 @@ struct RenderArgs {
     height: Option<u32>,
     #[arg(long)]
     seed: Option<u64>,
+    /// analytic: volumetric shadows (the lit intervals of each ray).
+    #[arg(long)]
+    shadows: bool,
+    /// analytic: points per dimension over line and quad lights.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=4096))]
+    light_steps: Option<u32>,
+    /// analytic: gauss (Gauss–Legendre) or uniform (the seed's stepping) over lights.
+    #[arg(long, value_parser = parse_light_quadrature)]
+    light_quadrature: Option<LightQuadrature>,
     /// Worker threads (default: all cores). The image does not depend on it.
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
     threads: Option<u32>,
@@ -88,6 +98,16 @@ fn main() -> ExitCode {
             eprintln!("error: {message}");
             ExitCode::FAILURE
         }
+    }
+}
+
+fn parse_light_quadrature(s: &str) -> Result<LightQuadrature, String> {
+    match s {
+        "gauss" => Ok(LightQuadrature::Gauss),
+        "uniform" => Ok(LightQuadrature::Uniform),
+        _ => Err(format!(
+            "unknown light quadrature `{s}`; expected gauss or uniform"
+        )),
     }
 }
 
@@ -120,6 +140,15 @@ fn render(args: RenderArgs) -> Result<(), String> {
     }
     if let Some(v) = args.seed {
         s.seed = v;
+    }
+    if args.shadows {
+        s.shadows = true;
+    }
+    if let Some(v) = args.light_steps {
+        s.light_steps = v;
+    }
+    if let Some(v) = args.light_quadrature {
+        s.light_quadrature = v;
     }
     let outputs = if args.output.is_empty() {
         vec![match &args.scene {

@@ -1,9 +1,11 @@
 //! Integrators: each turns a camera ray into the radiance arriving along it.
 //! They share one trait; the scene's `[render] integrator` picks one.
 
+pub mod analytic;
 mod direct;
 mod raymarch;
 
+pub use analytic::Analytic;
 pub use direct::Direct;
 pub use raymarch::Raymarch;
 
@@ -92,8 +94,12 @@ pub fn for_scene(scene: &Scene) -> Result<Box<dyn Integrator>, String> {
             steps: s.steps,
             jitter: s.jitter,
         })),
+        IntegratorKind::Analytic => Ok(Box::new(Analytic::new(
+            scene,
+            analytic::AnalyticOptions::from_settings(s),
+        )?)),
         other => Err(format!(
-            "the `{other}` integrator is not implemented yet; available: direct, raymarch"
+            "the `{other}` integrator is not implemented yet; available: direct, raymarch, analytic"
         )),
     }
 }

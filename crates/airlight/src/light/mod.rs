@@ -1,5 +1,6 @@
 //! Lights, in the units of DESIGN.md: point and spot `intensity` in W/sr,
-//! distant `irradiance` on a facing surface, sphere and quad `radiance`.
+//! distant `irradiance` on a facing surface, sphere and quad `radiance`, line
+//! `intensity` per unit length (W/(sr·m)).
 
 mod spot;
 
@@ -42,6 +43,15 @@ pub enum Light {
         edge_u: Vec3,
         edge_v: Vec3,
         radiance: Rgb,
+    },
+    /// A glowing segment, a neon tube too thin to see or hit: each element
+    /// dl of it radiates `intensity`·dl (W/sr) equally in all directions, so
+    /// `intensity` is W/(sr·m), and the whole line seen from afar acts as a
+    /// point light of intensity `intensity`·length.
+    Line {
+        start: Vec3,
+        end: Vec3,
+        intensity: Rgb,
     },
 }
 
@@ -110,11 +120,20 @@ impl Light {
         }
     }
 
-    /// Whether the light is a point or direction (no area to hit or sample).
+    pub fn line(start: Vec3, end: Vec3, intensity: Rgb) -> Self {
+        Light::Line {
+            start,
+            end,
+            intensity,
+        }
+    }
+
+    /// Whether the light has no surface to hit or sample by solid angle
+    /// (point, spot, distant, line).
     pub fn is_delta(&self) -> bool {
         matches!(
             self,
-            Light::Point { .. } | Light::Spot { .. } | Light::Distant { .. }
+            Light::Point { .. } | Light::Spot { .. } | Light::Distant { .. } | Light::Line { .. }
         )
     }
 
@@ -170,6 +189,27 @@ impl Light {
                 radius,
                 radiance,
             } => sample_sphere(center, radius, radiance, p, u),
+            Light::Line {
+                start,
+                end,
+                intensity,
+            } => {
+                // A point uniform along the line (pdf 1/length): its
+                // intensity·length, as a point light, over the squared distance.
+                let x = start + (end - start) * u.x;
+                let to = x - p;
+                let d2 = to.length_squared();
+                if d2 == 0.0 {
+                    return None;
+                }
+                let distance = d2.sqrt();
+                Some(LightSample {
+                    wi: to / distance,
+                    distance,
+                    weight: intensity * ((end - start).length() / d2),
+                    pdf: 0.0,
+                })
+            }
             Light::Quad {
                 corner,
                 edge_u,

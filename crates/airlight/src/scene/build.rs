@@ -146,6 +146,24 @@ impl Checker<'_> {
         if let Some(j) = r.jitter {
             s.jitter = j;
         }
+        if let Some(v) = r.shadows {
+            s.shadows = v;
+        }
+        s.light_steps = count(&r.light_steps, "light_steps", 1, s.light_steps)?;
+        if let Some(v) = &r.light_steps
+            && *v.get_ref() > 4096
+        {
+            return Err(self.err(
+                v.span(),
+                format!(
+                    "render.light_steps must be at most 4096, got {}",
+                    v.get_ref()
+                ),
+            ));
+        }
+        if let Some(q) = r.light_quadrature {
+            s.light_quadrature = q;
+        }
         Ok(s)
     }
 
@@ -590,7 +608,7 @@ impl Checker<'_> {
         let l = desc.get_ref();
         let kind = format!("{:?}", l.kind).to_lowercase();
         let label = format!("lights[{index}] ({kind})");
-        let fields: [(&str, bool); 14] = [
+        let fields: [(&str, bool); 16] = [
             ("position", l.position.is_some()),
             ("intensity", l.intensity.is_some()),
             ("direction", l.direction.is_some()),
@@ -605,6 +623,8 @@ impl Checker<'_> {
             ("corner", l.corner.is_some()),
             ("edge_u", l.edge_u.is_some()),
             ("edge_v", l.edge_v.is_some()),
+            ("start", l.start.is_some()),
+            ("end", l.end.is_some()),
         ];
         let at = |name: &str| format!("{label}.{name}");
         let point =
@@ -740,6 +760,24 @@ impl Checker<'_> {
                     v,
                     power(l.radiance, "radiance")?,
                 ))
+            }
+            LightType::Line => {
+                self.check_fields(
+                    span.clone(),
+                    &label,
+                    &kind,
+                    &fields,
+                    &["start", "end", "intensity"],
+                )?;
+                let (a, b) = (point(l.start, "start")?, point(l.end, "end")?);
+                if a == b {
+                    return Err(self.err_field(
+                        span,
+                        "end",
+                        format!("{label}: start and end must differ"),
+                    ));
+                }
+                Ok(Light::line(a, b, power(l.intensity, "intensity")?))
             }
         }
     }

@@ -3,6 +3,7 @@
 //! and turns them into a [`Scene`](super::Scene).
 
 use crate::integrator::IntegratorKind;
+use crate::integrator::analytic::LightQuadrature;
 use crate::light::SpotProfile;
 use crate::scene::Tonemap;
 use glam::Vec3;
@@ -43,6 +44,9 @@ pub struct RenderDesc {
     pub exposure: Option<Spanned<f32>>,
     pub tonemap: Option<Tonemap>,
     pub jitter: Option<bool>,
+    pub shadows: Option<bool>,
+    pub light_steps: Option<Spanned<i64>>,
+    pub light_quadrature: Option<LightQuadrature>,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
@@ -161,6 +165,7 @@ pub enum LightType {
     Distant,
     Sphere,
     Quad,
+    Line,
 }
 
 /// One `[[lights]]` table; as for objects, the fields a type needs are
@@ -184,6 +189,8 @@ pub struct LightDesc {
     pub corner: Option<Point>,
     pub edge_u: Option<Point>,
     pub edge_v: Option<Point>,
+    pub start: Option<Point>,
+    pub end: Option<Point>,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]

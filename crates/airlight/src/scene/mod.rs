@@ -13,6 +13,7 @@ use crate::Rgb;
 use crate::camera::Camera;
 use crate::geometry::{Geometry, GeometryBuilder, Shape};
 use crate::integrator::IntegratorKind;
+use crate::integrator::analytic::LightQuadrature;
 use crate::light::Light;
 use crate::material::Material;
 use crate::medium::Medium;
@@ -52,6 +53,12 @@ pub struct RenderSettings {
     pub tonemap: Tonemap,
     /// Offset march samples by a random fraction of a step per pixel sample.
     pub jitter: bool,
+    /// analytic: volumetric shadows (lit intervals of each ray).
+    pub shadows: bool,
+    /// analytic: points per dimension of a line or quad light's superposition.
+    pub light_steps: u32,
+    /// analytic: how those points are placed and weighted.
+    pub light_quadrature: LightQuadrature,
 }
 
 impl Default for RenderSettings {
@@ -69,6 +76,9 @@ impl Default for RenderSettings {
             exposure: 0.0,
             tonemap: Tonemap::Clamp,
             jitter: true,
+            shadows: false,
+            light_steps: 16,
+            light_quadrature: LightQuadrature::Gauss,
         }
     }
 }
@@ -195,6 +205,9 @@ impl SceneBuilder {
         if settings.steps == 0 {
             return Err(SceneError::new("steps must be at least 1"));
         }
+        if settings.light_steps == 0 {
+            return Err(SceneError::new("light_steps must be at least 1"));
+        }
         let camera = camera.unwrap_or_else(default_camera);
         let mut geometry = GeometryBuilder::default();
         for (shape, name) in &objects {
@@ -277,6 +290,10 @@ fn bounding_sphere(geometry: &Geometry, lights: &[Light], camera: &Camera) -> (V
                 ] {
                     grow(p);
                 }
+            }
+            Light::Line { start, end, .. } => {
+                grow(start);
+                grow(end);
             }
             Light::Distant { .. } => {}
         }
