@@ -114,7 +114,8 @@ fn integrate(f: &dyn Fn(f64) -> f64, a: f64, b: f64, cuts: &[f64], rel: f64) -> 
 #[test]
 fn the_numeric_integrator_is_right() {
     // The oracle itself, on integrals with known values.
-    let cases: [(&dyn Fn(f64) -> f64, f64, f64, f64); 3] = [
+    type Case<'a> = (&'a dyn Fn(f64) -> f64, f64, f64, f64);
+    let cases: [Case; 3] = [
         (&|x: f64| x.exp(), 0.0, 3.0, 3f64.exp() - 1.0),
         (
             &|x: f64| 1.0 / (1e-4 + x * x),

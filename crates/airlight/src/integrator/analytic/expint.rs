@@ -72,6 +72,17 @@ impl Complex {
 
 const EULER_GAMMA: f64 = 0.577_215_664_901_532_9;
 
+/// 1/k for k < 80 (the series never needs more terms for |z| < 4).
+const INV: [f64; 80] = {
+    let mut t = [0.0; 80];
+    let mut k = 1;
+    while k < 80 {
+        t[k] = 1.0 / k as f64;
+        k += 1;
+    }
+    t
+};
+
 /// S(z) = e^z E₁(z) for Re z ≥ 0, z ≠ 0 (see the module's documentation).
 pub fn scaled_e1(z: Complex) -> Complex {
     if z.norm2() < 16.0 {
@@ -79,9 +90,9 @@ pub fn scaled_e1(z: Complex) -> Complex {
         let minus_z = z.scale(-1.0);
         let mut a = Complex::new(1.0, 0.0);
         let mut sum = Complex::new(0.0, 0.0);
-        for k in 1..80 {
-            a = a.mul(minus_z).scale(1.0 / k as f64);
-            let term = a.scale(1.0 / k as f64);
+        for &inv in &INV[1..] {
+            a = a.mul(minus_z).scale(inv);
+            let term = a.scale(inv);
             sum = sum.add(term);
             if term.norm2() <= 1e-34 * sum.norm2() {
                 break;

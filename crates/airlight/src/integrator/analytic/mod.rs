@@ -312,7 +312,7 @@ impl Analytic {
 
     /// Single-scattered radiance along `ray` over [0, t_end] from all lights.
     pub fn in_scattered(&self, scene: &Scene, medium: &Medium, ray: &Ray, t_end: f32) -> Rgb {
-        if medium.sigma_s == Rgb::ZERO || !(t_end > 0.0) {
+        if medium.sigma_s == Rgb::ZERO || t_end.is_nan() || t_end <= 0.0 {
             return Rgb::ZERO;
         }
         let o = ray.origin.as_dvec3();
@@ -322,11 +322,11 @@ impl Analytic {
         let mut total = DVec3::ZERO;
         let t_end = t_end as f64;
         for e in &self.emitters {
-            total += self.from_emitter(scene, &consts, o, d, t_end, e, &mut scratch);
+            total += self.emitter_light(scene, &consts, o, d, t_end, e, &mut scratch);
         }
         for x in &self.extended {
             let mut each = |e: &PointEmitter| {
-                total += self.from_emitter(scene, &consts, o, d, t_end, e, &mut scratch);
+                total += self.emitter_light(scene, &consts, o, d, t_end, e, &mut scratch);
             };
             match *x {
                 Extended::Line {
@@ -367,6 +367,7 @@ impl Analytic {
     /// below about 1e-6 for every n, and for the uniform rule it keeps the
     /// ray several point spacings away. A rule of n > 16 points splits
     /// log2(n/16) times fewer.
+    #[allow(clippy::too_many_arguments)]
     fn must_split(
         &self,
         o: DVec3,
@@ -466,7 +467,7 @@ impl Analytic {
 
     /// ∫ e^{−σt (t + r)} · phase · m / r² dt · I over [0, t_end], per channel.
     #[allow(clippy::too_many_arguments)]
-    fn from_emitter(
+    fn emitter_light(
         &self,
         scene: &Scene,
         k: &MediumConsts,
@@ -747,7 +748,7 @@ fn visible(scene: &Scene, x: DVec3, e: &PointEmitter) -> bool {
     let to = e.position - x;
     let dist = to.length();
     let reach = (dist - e.gap) * (1.0 - 1e-4);
-    if !(reach > 0.0) {
+    if reach.is_nan() || reach <= 0.0 {
         return true;
     }
     !scene
