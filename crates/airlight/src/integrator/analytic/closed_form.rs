@@ -102,7 +102,7 @@ fn y_plus_r(p: f64, y: f64) -> f64 {
 /// Im S → −arg z = π/2 − ξ and K tends to the seed's atan form. When the
 /// two values of K agree to 1e-3 (a short interval: the E₁ evaluation,
 /// good to about 1e-13 of K, would lose digits to cancellation) the difference is
-/// taken instead by 8-point Gauss–Legendre in t over the piece, where the
+/// taken instead by 8-point Gauss–Legendre in θ over the piece, where the
 /// integrand is nearly constant.
 #[derive(Clone, Copy, Debug)]
 pub struct Glow {
@@ -186,18 +186,20 @@ impl Glow {
         self.h + self.p * theta.tan()
     }
 
-    /// G by 8-point Gauss–Legendre in t, for short pieces (see above): in t
-    /// rather than θ, whose difference would lose digits when the piece is
-    /// tiny.
+    /// G by 8-point Gauss–Legendre in θ for short pieces (see above):
+    /// G = (1/p) ∫ e^{−σt (t + r)} dθ, with the width of the piece in θ
+    /// taken as atan2(p (t₁ − t₀), p² + a b) (a, b = t − h at its ends), which
+    /// keeps its digits however short the piece.
     fn quadrature(&self, t0: f64, t1: f64) -> f64 {
+        let (a, b) = (t0 - self.h, t1 - self.h);
+        let width = (self.p * (t1 - t0)).atan2(self.p * self.p + a * b);
+        let start = self.angle(t0);
         let rule = gl8();
         let mut sum = 0.0;
         for (x, w) in rule.nodes.iter().zip(&rule.weights) {
-            let y = t0 + (t1 - t0) * x - self.h;
-            let r2 = self.p * self.p + y * y;
-            sum += w * (-self.sigma_t * (self.h + y_plus_r(self.p, y))).exp() / r2;
+            sum += w * self.attenuation_at_angle(start + width * x);
         }
-        sum * (t1 - t0)
+        sum * width / self.p
     }
 }
 
