@@ -12,6 +12,8 @@ use glam::Vec2;
 use rayon::prelude::*;
 use std::path::PathBuf;
 
+mod common;
+
 fn scene_file(name: &str) -> Scene {
     let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
         .join("../../scenes")
@@ -410,4 +412,51 @@ fn scenes_the_analytic_integrator_cannot_render_say_why() {
     // A sun without a medium lights surfaces only: fine.
     let scene = airlight::scene::from_toml_str(&base("", sun), None).unwrap();
     assert!(integrator::for_scene(&scene).is_ok());
+}
+
+#[test]
+fn anisotropic_phase_along_rays_matches_numeric_integration() {
+    // A point light in fog with Henyey–Greenstein g: the analytic in-scatter
+    // along rays against adaptive quadrature of σs·HG·I·e^{−σt (t + r)}/r².
+    let (sigma_s, sigma_a, intensity) = (0.1f32, 0.03f32, 20.0f32);
+    let light = vec3(0.4, 2.0, 3.0);
+    for (g, bound) in [(0.3f32, 1e-4), (0.6, 1e-4), (-0.7, 1e-4), (0.9, 1e-4)] {
+        let scene = SceneBuilder::new()
+            .medium(Medium::homogeneous(
+                Rgb::splat(sigma_a),
+                Rgb::splat(sigma_s),
+                g,
+            ))
+            .light(Light::point(light, Rgb::splat(intensity)))
+            .build()
+            .unwrap();
+        let medium = scene.medium.unwrap();
+        let integrator = analytic(&scene, false, 16, LightQuadrature::Gauss);
+        let mut worst = 0.0f64;
+        for i in 0..200 {
+            let a = i as f32 * 0.7;
+            let dir = vec3(a.cos() * 0.5, (a * 1.3).sin() * 0.4, 1.0).normalize();
+            let origin = vec3(0.0, 1.5, -4.0 + (i % 7) as f32);
+            let t_end = 3.0 + (i % 11) as f32 * 2.0;
+            let ray = airlight::geometry::Ray::new(origin, dir);
+            let got = integrator.in_scattered(&scene, &medium, &ray, t_end).x as f64;
+            let (o, d, p) = (origin.as_dvec3(), dir.as_dvec3(), light.as_dvec3());
+            let st = (sigma_a + sigma_s) as f64;
+            let f = |t: f64| {
+                let to = p - (o + d * t);
+                let r = to.length();
+                let cos = -d.dot(to / r);
+                let hg = (1.0 - (g * g) as f64)
+                    / (4.0
+                        * std::f64::consts::PI
+                        * (1.0 + (g * g) as f64 + 2.0 * g as f64 * cos).powf(1.5));
+                sigma_s as f64 * intensity as f64 * hg * (-st * (t + r)).exp() / (r * r)
+            };
+            let foot = d.dot(p - o);
+            let expected = common::integrate(&f, 0.0, t_end as f64, &[foot], 1e-10);
+            worst = worst.max((got / expected - 1.0).abs());
+        }
+        println!("HG g = {g}: worst relative error {worst:.2e} over 200 rays");
+        assert!(worst <= bound, "g = {g}: {worst:e}");
+    }
 }

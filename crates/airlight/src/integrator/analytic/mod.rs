@@ -21,8 +21,12 @@
 //!   light's cosine) the exact integral of the attenuation alone is
 //!   multiplied by the mean of phase·m weighted by that attenuation, taken by
 //!   16-point Gauss–Legendre in the angle θ = atan((t − h)/p), in panels of at
-//!   most π/4 (the variable in which dt/r² = dθ/p is uniform). The tests
-//!   state the error.
+//!   most π/4 (the variable in which dt/r² = dθ/p is uniform). Measured
+//!   against adaptive quadrature along 200 rays (σt = 0.13, tests/
+//!   analytic_render.rs): worst relative error 1.2e-6 (g = 0.3), 1.7e-6
+//!   (g = 0.6), 6.4e-6 (g = 0.9), 1.6e-5 (g = −0.7); isotropic pieces are
+//!   exact. A soft spot edge, with 32768-step marching as reference, agrees
+//!   to 1.4e-4 relative RMSE (the march's own error).
 //!
 //! Line and quad lights are sums of such point lights ([`LightQuadrature`],
 //! `light_steps` points per dimension), as the seed superposes them. A fixed
