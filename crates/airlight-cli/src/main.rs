@@ -2,6 +2,7 @@
 
 use airlight::film::{self, Image};
 use airlight::integrator::IntegratorKind;
+use airlight::integrator::analytic::LightQuadrature;
 use airlight::render::{RenderObserver, render_with};
 use airlight::scene::{self, Scene};
 use clap::{Parser, Subcommand};
@@ -54,7 +55,7 @@ struct RenderArgs {
     /// Default: airlight.png for the demo, else the scene's name with .png.
     #[arg(short, long = "output", value_name = "OUT")]
     output: Vec<PathBuf>,
-    /// Integrator: direct, raymarch, radiosity (analytic, stochastic, path are planned).
+    /// Integrator: direct, raymarch, analytic, path, radiosity (stochastic with the SDF work).
     #[arg(long)]
     integrator: Option<IntegratorKind>,
     /// Samples per pixel.
@@ -73,6 +74,15 @@ struct RenderArgs {
     /// cutoff, window_tan, window_rational, window_ue4 (each keeps its cutoff).
     #[arg(long, value_parser = parse_attenuation)]
     attenuation: Option<airlight::light::AttenuationModel>,
+    /// analytic: volumetric shadows (the lit intervals of each ray).
+    #[arg(long)]
+    shadows: bool,
+    /// analytic: points per dimension over line and quad lights.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=4096))]
+    light_steps: Option<u32>,
+    /// analytic: gauss (Gauss–Legendre) or uniform (the seed's stepping) over lights.
+    #[arg(long, value_parser = parse_light_quadrature)]
+    light_quadrature: Option<LightQuadrature>,
     /// Worker threads (default: all cores). The image does not depend on it.
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
     threads: Option<u32>,
@@ -150,6 +160,14 @@ fn main() -> ExitCode {
     }
 }
 
+fn parse_light_quadrature(s: &str) -> Result<LightQuadrature, String> {
+    match s {
+        "gauss" => Ok(LightQuadrature::Gauss),
+        "uniform" => Ok(LightQuadrature::Uniform),
+        _ => Err(format!("unknown light quadrature `{s}`; expected gauss or uniform")),
+    }
+}
+
 fn load(path: Option<&Path>) -> Result<Scene, String> {
     match path {
         Some(path) => scene::load(path).map_err(|e| e.to_string()),
@@ -186,6 +204,15 @@ fn render(args: RenderArgs) -> Result<(), String> {
             }
         }
         scene.light_culling = airlight::scene::LightCulling::new(&scene.lights);
+    }
+    if args.shadows {
+        s.shadows = true;
+    }
+    if let Some(v) = args.light_steps {
+        s.light_steps = v;
+    }
+    if let Some(v) = args.light_quadrature {
+        s.light_quadrature = v;
     }
     let outputs = if args.output.is_empty() {
         vec![match &args.scene {

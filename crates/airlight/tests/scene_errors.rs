@@ -225,3 +225,38 @@ fn garbage_never_panics() {
         assert!(from_toml_str(odd, None).is_err(), "{odd:?}");
     }
 }
+
+#[test]
+fn analytic_settings_and_line_lights_are_checked() {
+    let tail = "[materials.white]\nalbedo = 0.8\n";
+    for (text, line, phrase) in [
+        ("[render]\nlight_steps = 0\n", 2, "render.light_steps must be an integer ≥ 1, got 0"),
+        ("[render]\nlight_steps = 5000\n", 2, "render.light_steps must be at most 4096, got 5000"),
+        ("[render]\nshadows = 1\n", 2, "invalid type: integer `1`, expected a boolean"),
+        ("[render]\nlight_quadrature = \"simpson\"\n", 2, "unknown variant `simpson`"),
+        ("[[lights]]\ntype = \"line\"\nstart = [0, 1, 0]\nintensity = 3\n", 1, "a line needs `end`"),
+        (
+            "[[lights]]\ntype = \"line\"\nstart = [0, 1, 0]\nend = [0, 1, 0]\nintensity = 3\n",
+            4,
+            "start and end must differ",
+        ),
+        (
+            "[[lights]]\ntype = \"point\"\nposition = [0, 1, 0]\nend = [0, 1, 0]\nintensity = 3\n",
+            4,
+            "`end` does not belong to a point",
+        ),
+    ] {
+        let full = format!("{text}{tail}");
+        let e = error_of(&full);
+        assert!(e.message.contains(phrase), "{full}\n→ {e}");
+        assert_eq!(e.location.map(|l| l.0), Some(line), "{full}\n→ {e}");
+    }
+    let ok = airlight::scene::from_toml_str(
+        "[render]\nshadows = true\nlight_steps = 8\nlight_quadrature = \"uniform\"\n\
+         [[lights]]\ntype = \"line\"\nstart = [0, 1, 0]\nend = [1, 1, 0]\nintensity = 3\n",
+        None,
+    )
+    .unwrap();
+    assert!(ok.settings.shadows);
+    assert_eq!(ok.settings.light_steps, 8);
+}

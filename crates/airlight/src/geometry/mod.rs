@@ -4,6 +4,6 @@ mod accel;
 mod ray;
 mod shape;
 
-pub use accel::{Geometry, GeometryBuilder, Hit, SurfaceHit, shadow_rays_traced};
+pub use accel::{Geometry, GeometryBuilder, Hit, Occluder, SurfaceHit, shadow_rays_traced};
 pub use ray::{Ray, offset_origin};
 pub use shape::{Shape, intersect_box, intersect_quad, intersect_sphere, intersect_triangle};

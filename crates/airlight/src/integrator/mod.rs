@@ -1,11 +1,13 @@
 //! Integrators: each turns a camera ray into the radiance arriving along it.
 //! They share one trait; the scene's `[render] integrator` picks one.
 
+pub mod analytic;
 mod direct;
 pub mod path;
 mod radiosity;
 mod raymarch;
 
+pub use analytic::Analytic;
 pub use direct::Direct;
 pub use path::PathTracer;
 pub use radiosity::RadiosityIntegrator;
@@ -89,8 +91,9 @@ pub fn for_scene(scene: &Scene) -> Result<Box<dyn Integrator>, String> {
         IntegratorKind::Raymarch => Ok(Box::new(Raymarch { steps: s.steps, jitter: s.jitter })),
         IntegratorKind::Path => Ok(Box::new(PathTracer { max_depth: s.max_depth })),
         IntegratorKind::Radiosity => Ok(Box::new(RadiosityIntegrator::new(scene).map_err(|e| e.to_string())?)),
+        IntegratorKind::Analytic => Ok(Box::new(Analytic::new(scene, analytic::AnalyticOptions::from_settings(s))?)),
         other => Err(format!(
-            "the `{other}` integrator is not implemented yet; available: direct, raymarch, path, radiosity"
+            "the `{other}` integrator is not implemented yet; available: direct, raymarch, analytic, path, radiosity"
         )),
     }
 }

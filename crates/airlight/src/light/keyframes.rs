@@ -79,6 +79,7 @@ impl Light {
             Light::Point { position, .. } | Light::Spot { position, .. } => Some(position),
             Light::Sphere { center, .. } => Some(center),
             Light::Quad { corner, edge_u, edge_v, .. } => Some(corner + 0.5 * (edge_u + edge_v)),
+            Light::Line { start, end, .. } => Some(0.5 * (start + end)),
             Light::Distant { .. } => None,
         }
     }
@@ -90,6 +91,10 @@ impl Light {
             Light::Point { position, .. } | Light::Spot { position, .. } => *position = p,
             Light::Sphere { center, .. } => *center = p,
             Light::Quad { corner, edge_u, edge_v, .. } => *corner = p - 0.5 * (*edge_u + *edge_v),
+            Light::Line { start, end, .. } => {
+                let half = 0.5 * (*end - *start);
+                (*start, *end) = (p - half, p + half);
+            }
             Light::Distant { .. } => {}
         }
         self

@@ -1,5 +1,6 @@
 //! Lights, in the units of DESIGN.md: point and spot `intensity` in W/sr,
-//! distant `irradiance` on a facing surface, sphere and quad `radiance`.
+//! distant `irradiance` on a facing surface, sphere and quad `radiance`, line
+//! `intensity` per unit length (W/(sr·m)).
 
 mod attenuation;
 mod keyframes;
@@ -52,6 +53,15 @@ pub enum Light {
         edge_u: Vec3,
         edge_v: Vec3,
         radiance: Rgb,
+    },
+    /// A glowing segment, a neon tube too thin to see or hit: each element
+    /// dl of it radiates `intensity`·dl (W/sr) equally in all directions, so
+    /// `intensity` is W/(sr·m), and the whole line seen from afar acts as a
+    /// point light of intensity `intensity`·length.
+    Line {
+        start: Vec3,
+        end: Vec3,
+        intensity: Rgb,
     },
 }
 
@@ -148,9 +158,14 @@ impl Light {
         Light::Quad { corner, edge_u, edge_v, radiance }
     }
 
-    /// Whether the light is a point or direction (no area to hit or sample).
+    pub fn line(start: Vec3, end: Vec3, intensity: Rgb) -> Self {
+        Light::Line { start, end, intensity }
+    }
+
+    /// Whether the light has no surface to hit or sample by solid angle
+    /// (point, spot, distant, line).
     pub fn is_delta(&self) -> bool {
-        matches!(self, Light::Point { .. } | Light::Spot { .. } | Light::Distant { .. })
+        matches!(self, Light::Point { .. } | Light::Spot { .. } | Light::Distant { .. } | Light::Line { .. })
     }
 
     /// Samples light arriving at `p`; `u` uniform in [0, 1)². None when no light
@@ -179,6 +194,23 @@ impl Light {
                     Some(LightSample { wi, distance: (distance - radius).max(0.0), weight, pdf: 0.0 })
                 }
             },
+            Light::Line { start, end, intensity } => {
+                // A point uniform along the line (pdf 1/length): its
+                // intensity·length, as a point light, over the squared distance.
+                let x = start + (end - start) * u.x;
+                let to = x - p;
+                let d2 = to.length_squared();
+                if d2 == 0.0 {
+                    return None;
+                }
+                let distance = d2.sqrt();
+                Some(LightSample {
+                    wi: to / distance,
+                    distance,
+                    weight: intensity * ((end - start).length() / d2),
+                    pdf: 0.0,
+                })
+            }
             Light::Quad { corner, edge_u, edge_v, radiance } => {
                 let x = corner + edge_u * u.x + edge_v * u.y;
                 let to = x - p;

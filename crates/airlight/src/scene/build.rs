@@ -157,6 +157,18 @@ impl Checker<'_> {
         if let Some(t) = &r.link_threshold {
             s.link_threshold = self.positive(t.span(), "render.link_threshold", *t.get_ref())?;
         }
+        if let Some(v) = r.shadows {
+            s.shadows = v;
+        }
+        s.light_steps = count(&r.light_steps, "light_steps", 1, s.light_steps)?;
+        if let Some(v) = &r.light_steps
+            && *v.get_ref() > 4096
+        {
+            return Err(self.err(v.span(), format!("render.light_steps must be at most 4096, got {}", v.get_ref())));
+        }
+        if let Some(q) = r.light_quadrature {
+            s.light_quadrature = q;
+        }
         Ok(s)
     }
 
@@ -499,7 +511,7 @@ impl Checker<'_> {
         let l = desc.get_ref();
         let kind = format!("{:?}", l.kind).to_lowercase();
         let label = format!("lights[{index}] ({kind})");
-        let fields: [(&str, bool); 17] = [
+        let fields: [(&str, bool); 19] = [
             ("position", l.position.is_some()),
             ("intensity", l.intensity.is_some()),
             ("direction", l.direction.is_some()),
@@ -517,6 +529,8 @@ impl Checker<'_> {
             ("attenuation", l.attenuation.is_some()),
             ("cutoff", l.cutoff.is_some()),
             ("range", l.range.is_some()),
+            ("start", l.start.is_some()),
+            ("end", l.end.is_some()),
         ];
         let at = |name: &str| format!("{label}.{name}");
         let point = |p: Option<Point>, name: &str| self.finite3(span.clone(), &at(name), p.unwrap().0);
@@ -593,6 +607,14 @@ impl Checker<'_> {
                     ));
                 }
                 return Ok(Light::quad(point(l.corner, "corner")?, u, v, power(l.radiance, "radiance")?));
+            }
+            LightType::Line => {
+                check(&["start", "end", "intensity"], &[])?;
+                let (a, b) = (point(l.start, "start")?, point(l.end, "end")?);
+                if a == b {
+                    return Err(self.err_field(span, "end", format!("{label}: start and end must differ")));
+                }
+                return Ok(Light::line(a, b, power(l.intensity, "intensity")?));
             }
         };
         // The falloff of a point, spot or sphere light.

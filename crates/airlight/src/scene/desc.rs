@@ -3,6 +3,7 @@
 //! and turns them into a [`Scene`](super::Scene).
 
 use crate::integrator::IntegratorKind;
+use crate::integrator::analytic::LightQuadrature;
 use crate::light::{AttenuationModel, SpotProfile};
 use crate::scene::Tonemap;
 use glam::Vec3;
@@ -53,6 +54,9 @@ pub struct RenderDesc {
     /// Radiosity: largest estimated form factor A/(π d²) of a cluster that a
     /// patch links to as a whole (default 0.02).
     pub link_threshold: Option<Spanned<f32>>,
+    pub shadows: Option<bool>,
+    pub light_steps: Option<Spanned<i64>>,
+    pub light_quadrature: Option<LightQuadrature>,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
@@ -171,6 +175,7 @@ pub enum LightType {
     Distant,
     Sphere,
     Quad,
+    Line,
 }
 
 /// One `[[lights]]` table; as for objects, the fields a type needs are
@@ -194,6 +199,8 @@ pub struct LightDesc {
     pub corner: Option<Point>,
     pub edge_u: Option<Point>,
     pub edge_v: Option<Point>,
+    pub start: Option<Point>,
+    pub end: Option<Point>,
     /// Point, spot and sphere lights: how light falls off with distance.
     pub attenuation: Option<AttenuationModel>,
     /// Irradiance below which a finite-range falloff drops the light.

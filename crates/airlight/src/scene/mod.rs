@@ -15,6 +15,7 @@ use crate::Rgb;
 use crate::camera::Camera;
 use crate::geometry::{Geometry, GeometryBuilder, Shape};
 use crate::integrator::IntegratorKind;
+use crate::integrator::analytic::LightQuadrature;
 use crate::light::{Keyframes, Light};
 use crate::material::Material;
 use crate::medium::Medium;
@@ -54,6 +55,12 @@ pub struct RenderSettings {
     pub tonemap: Tonemap,
     /// Offset march samples by a random fraction of a step per pixel sample.
     pub jitter: bool,
+    /// analytic: volumetric shadows (lit intervals of each ray).
+    pub shadows: bool,
+    /// analytic: points per dimension of a line or quad light's superposition.
+    pub light_steps: u32,
+    /// analytic: how those points are placed and weighted.
+    pub light_quadrature: LightQuadrature,
     /// Radiosity: the side length (world units) surfaces are cut into
     /// patches of; None picks 1/32 of the largest extent of the bounded
     /// geometry (see `radiosity::CompileParams`).
@@ -101,6 +108,9 @@ impl Default for RenderSettings {
             patch_size: None,
             bounces: 1,
             link_threshold: DEFAULT_LINK_THRESHOLD,
+            shadows: false,
+            light_steps: 16,
+            light_quadrature: LightQuadrature::Gauss,
         }
     }
 }
@@ -289,6 +299,9 @@ impl SceneBuilder {
         if settings.steps == 0 {
             return Err(SceneError::new("steps must be at least 1"));
         }
+        if settings.light_steps == 0 {
+            return Err(SceneError::new("light_steps must be at least 1"));
+        }
         let camera = camera.unwrap_or_else(default_camera);
         if settings.bounces == 0 {
             return Err(SceneError::new("bounces must be at least 1"));
@@ -366,6 +379,10 @@ fn bounding_sphere(geometry: &Geometry, lights: &[Light], camera: &Camera) -> (V
                 for p in [corner, corner + edge_u, corner + edge_v, corner + edge_u + edge_v] {
                     grow(p);
                 }
+            }
+            Light::Line { start, end, .. } => {
+                grow(start);
+                grow(end);
             }
             Light::Distant { .. } => {}
         }

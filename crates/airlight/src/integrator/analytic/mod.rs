@@ -1,0 +1,374 @@
+//! Closed-form single-scatter airlight (issue 4), after Packard 2004 (the
+//! seed `packard-2004-glowing-lights.txt`) and Sun, Ramamoorthi, Narasimhan
+//! and Nayar 2005.
+//!
+//! Along a camera ray o + t·d the radiance is the surface term attenuated
+//! by the transmittance, plus, for each point light of intensity I at P,
+//!
+//!   σs ∫_0^{t_end} e^{−σt t} · phase(t) · m(t) · I e^{−σt r(t)} / r(t)² dt,
+//!
+//! r(t) = |o + t d − P|. m(t) is 1 for a point light, the spot's falloff
+//! for a spot light, the emission cosine for a point of a quad light, and 0
+//! where the point is in shadow (with `shadows`). The ray is cut where m
+//! jumps or its formula changes (spot cones, a quad light's plane, shadow
+//! boundaries); on each piece:
+//!
+//! - when phase·m is constant (isotropic phase, inside a spot's inner cone,
+//!   lit), the integral is exact: [`glow_vacuum`] (the seed's atan form) for
+//!   σt = 0, [`Glow`] (Sun et al.'s F through the complex exponential
+//!   integral) for σt > 0;
+//! - otherwise (Henyey–Greenstein with g ≠ 0, a spot's soft edge, a quad
+//!   light's cosine) the exact integral of the attenuation alone is
+//!   multiplied by the mean of phase·m weighted by that attenuation, taken by
+//!   16-point Gauss–Legendre in the angle θ = atan((t − h)/p), in panels of at
+//!   most π/4 (the variable in which dt/r² = dθ/p is uniform). Measured
+//!   against adaptive quadrature along 200 rays (σt = 0.13, tests/
+//!   analytic_render.rs): worst relative error 1.2e-6 (g = 0.3), 1.7e-6
+//!   (g = 0.6), 6.4e-6 (g = 0.9), 1.6e-5 (g = −0.7); isotropic pieces are
+//!   exact. A soft spot edge, with 32768-step marching as reference, agrees
+//!   to 1.4e-4 relative RMSE (the march's own error).
+//!
+//! Line and quad lights are sums of such point lights ([`LightQuadrature`],
+//! `light_steps` points per dimension), as the seed superposes them. A fixed
+//! set of points fails for rays that pass closer to the light than a few
+//! point spacings (each point then shows its own glow), so per ray a piece
+//! of the light that the ray passes close to is halved (line, up to 8
+//! times) or quartered (quad, up to 3 times) and the rule applied on each
+//! part: an adaptive composite rule, which leaves far rays with n points. A sphere light of radiance L and
+//! radius R is, for points outside it, exactly a point light of intensity
+//! πR²L at its centre (a Lambertian sphere's radiant intensity; exact for
+//! isotropic scattering when the extinction along the different paths from
+//! its surface is neglected, O(σt R)).
+
+mod boundaries;
+mod closed_form;
+mod expint;
+mod lights;
+mod modulation;
+mod quadrature;
+mod shadows;
+
+pub use boundaries::{
+    box_boundaries, box_edges, cone_crossings, edge_boundaries, plane_boundaries, polygon_boundaries, quadratic_roots,
+    sphere_boundaries,
+};
+pub use closed_form::{Glow, P_FLOOR, glow_extinction, glow_vacuum, glow_vacuum_f32, seed_coordinates, sun_f};
+pub use expint::{Complex, scaled_e1};
+pub use lights::sphere_factor;
+pub use quadrature::Rule;
+
+use lights::Extended;
+use modulation::MediumConsts;
+use shadows::visible;
+
+use super::{Integrator, surface_radiance};
+use crate::Rgb;
+use crate::geometry::{Occluder, Ray};
+use crate::light::{Light, SpotProfile};
+use crate::medium::{Density, Medium};
+use crate::sampling::Sampler;
+use crate::scene::{RenderSettings, Scene};
+use glam::{DVec3, Vec3};
+use serde::Deserialize;
+
+/// How the points of a line or quad light are placed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum LightQuadrature {
+    /// Gauss–Legendre nodes and weights along each edge.
+    #[default]
+    Gauss,
+    /// The seed's uniform stepping: the middles of equal cells, equal weights.
+    Uniform,
+}
+
+/// The analytic integrator's settings (`[render]` shadows, light_steps,
+/// light_quadrature).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AnalyticOptions {
+    pub shadows: bool,
+    pub light_steps: u32,
+    pub quadrature: LightQuadrature,
+}
+
+impl AnalyticOptions {
+    pub fn from_settings(s: &RenderSettings) -> Self {
+        AnalyticOptions { shadows: s.shadows, light_steps: s.light_steps, quadrature: s.light_quadrature }
+    }
+}
+
+/// How a point emitter's intensity varies with direction.
+#[derive(Clone, Copy, Debug)]
+enum Emission {
+    Isotropic,
+    Spot {
+        axis: DVec3,
+        cos_outer: f64,
+        cos_inner: f64,
+        cone: f32,
+        start: f32,
+        profile: SpotProfile,
+    },
+    /// A point of a one-sided Lambertian emitter: intensity × cos of the
+    /// angle to `normal`, zero behind.
+    Cosine {
+        normal: DVec3,
+    },
+    /// The centre of a sphere light of this radius, with intensity πR²L: see
+    /// [`sphere_factor`] for the near-field correction.
+    Sphere {
+        radius: f64,
+    },
+}
+
+/// A point light, or one point of a line, quad or sphere light.
+#[derive(Clone, Copy, Debug)]
+struct PointEmitter {
+    position: DVec3,
+    /// W/sr (for `Cosine`, along the normal).
+    intensity: DVec3,
+    emission: Emission,
+    /// Index of the scene light it belongs to (its own surface casts no shadow).
+    light: u32,
+    /// Shadow rays stop this far short of `position` (a sphere light's radius).
+    gap: f64,
+}
+
+/// The closed-form airlight integrator (see the module documentation).
+pub struct Analytic {
+    pub options: AnalyticOptions,
+    emitters: Vec<PointEmitter>,
+    /// Line and quad lights, superposed per ray.
+    extended: Vec<Extended>,
+    /// The rule over each piece of a line or quad light, on [0, 1].
+    rule: Rule,
+    /// Whether some occluder is a triangle: shadow boundaries on meshes are
+    /// bracketed by a coarse march and refined by bisection.
+    meshes: bool,
+}
+
+/// Coarse march samples per ray for shadow boundaries on meshes.
+pub const MESH_MARCH_STEPS: usize = 64;
+/// Gauss–Legendre points per panel for a non-constant phase or emission.
+const MODULATED_POINTS: usize = 16;
+
+impl Analytic {
+    /// The integrator for `scene`, or why it cannot render it: the medium
+    /// must be homogeneous, and distant lights have no closed form here.
+    pub fn new(scene: &Scene, options: AnalyticOptions) -> Result<Analytic, String> {
+        let in_medium = scene.medium.as_ref().is_some_and(|m| m.sigma_s != Rgb::ZERO);
+        if let Some(m) = &scene.medium
+            && let Density::Height { .. } = m.density
+        {
+            return Err("the analytic integrator needs a homogeneous medium; \
+                        this scene's is height fog: use raymarch"
+                .into());
+        }
+        if options.light_steps == 0 {
+            return Err("light_steps must be at least 1".into());
+        }
+        let n = options.light_steps as usize;
+        let rule = match options.quadrature {
+            LightQuadrature::Gauss => Rule::gauss_legendre(n),
+            LightQuadrature::Uniform => Rule::uniform(n),
+        };
+        let mut emitters = Vec::new();
+        let mut extended = Vec::new();
+        for (i, light) in scene.lights.iter().enumerate() {
+            let index = i as u32;
+            let point = |position: Vec3, intensity: Rgb, emission, gap| PointEmitter {
+                position: position.as_dvec3(),
+                intensity: intensity.as_dvec3(),
+                emission,
+                light: index,
+                gap,
+            };
+            match *light {
+                Light::Point { position, intensity, .. } => {
+                    emitters.push(point(position, intensity, Emission::Isotropic, 0.0))
+                }
+                Light::Spot { position, direction, intensity, cone_angle, falloff_start, profile, .. } => emitters
+                    .push(point(
+                        position,
+                        intensity,
+                        Emission::Spot {
+                            axis: direction.as_dvec3().normalize(),
+                            cos_outer: (cone_angle as f64).cos(),
+                            cos_inner: (falloff_start as f64).cos(),
+                            cone: cone_angle,
+                            start: falloff_start,
+                            profile,
+                        },
+                        0.0,
+                    )),
+                Light::Sphere { center, radius, radiance, .. } => emitters.push(point(
+                    center,
+                    radiance * (std::f32::consts::PI * radius * radius),
+                    Emission::Sphere { radius: radius as f64 },
+                    radius as f64,
+                )),
+                Light::Line { start, end, intensity } => {
+                    let (a, b) = (start.as_dvec3(), end.as_dvec3());
+                    extended.push(Extended::Line {
+                        start: a,
+                        end: b,
+                        intensity: intensity.as_dvec3() * (b - a).length(),
+                        light: index,
+                    });
+                }
+                Light::Quad { corner, edge_u, edge_v, radiance } => {
+                    let (u, v) = (edge_u.as_dvec3(), edge_v.as_dvec3());
+                    let n = u.cross(v);
+                    // dI = L cos θ dA: the intensity along the normal is L·A.
+                    extended.push(Extended::Quad {
+                        corner: corner.as_dvec3(),
+                        edge_u: u,
+                        edge_v: v,
+                        normal: n.normalize(),
+                        intensity: radiance.as_dvec3() * n.length(),
+                        light: index,
+                    });
+                }
+                Light::Distant { .. } => {
+                    if in_medium {
+                        return Err(format!(
+                            "the analytic integrator has no closed form for the light a distant \
+                             light (lights[{i}]) scatters in a medium: use raymarch"
+                        ));
+                    }
+                }
+            }
+        }
+        emitters.retain(|e| e.intensity != DVec3::ZERO);
+        extended.retain(|e| e.intensity() != DVec3::ZERO);
+        let meshes = scene.geometry.occluders().any(|(o, _)| matches!(o, Occluder::Triangle { .. }));
+        Ok(Analytic { options, emitters, extended, rule, meshes })
+    }
+
+    /// Single-scattered radiance along `ray` over [0, t_end] from all lights.
+    pub fn in_scattered(&self, scene: &Scene, medium: &Medium, ray: &Ray, t_end: f32) -> Rgb {
+        if medium.sigma_s == Rgb::ZERO || t_end.is_nan() || t_end <= 0.0 {
+            return Rgb::ZERO;
+        }
+        let o = ray.origin.as_dvec3();
+        let d = ray.dir.as_dvec3().normalize();
+        let consts = MediumConsts::new(medium);
+        let mut scratch = Scratch::default();
+        let mut total = DVec3::ZERO;
+        let t_end = t_end as f64;
+        for e in &self.emitters {
+            total += self.emitter_light(scene, &consts, o, d, t_end, e, &mut scratch);
+        }
+        for x in &self.extended {
+            let mut each = |e: &PointEmitter| {
+                total += self.emitter_light(scene, &consts, o, d, t_end, e, &mut scratch);
+            };
+            match *x {
+                Extended::Line { start, end, intensity, light } => {
+                    self.line_pieces(o, d, t_end, (start, end), intensity, light, 0, &mut each)
+                }
+                Extended::Quad { corner, edge_u, edge_v, normal, intensity, light } => {
+                    self.quad_pieces(o, d, t_end, (corner, edge_u, edge_v), normal, intensity, light, 0, &mut each)
+                }
+            }
+        }
+        (total * medium.sigma_s.as_dvec3()).as_vec3()
+    }
+
+    /// ∫ e^{−σt (t + r)} · phase · m / r² dt · I over [0, t_end], per channel.
+    #[allow(clippy::too_many_arguments)]
+    fn emitter_light(
+        &self,
+        scene: &Scene,
+        k: &MediumConsts,
+        o: DVec3,
+        d: DVec3,
+        t_end: f64,
+        e: &PointEmitter,
+        s: &mut Scratch,
+    ) -> DVec3 {
+        let p = e.position;
+        let glows: [Glow; 3] = std::array::from_fn(|c| Glow::new(k.sigma_t[c], p, o, d, t_end));
+        let range = (0.0, t_end);
+        s.cuts.clear();
+        s.cuts.push(0.0);
+        s.cuts.push(t_end);
+        match e.emission {
+            Emission::Isotropic | Emission::Sphere { .. } => {}
+            Emission::Spot { axis, cos_outer, cos_inner, cone, start, .. } => {
+                cone_crossings(p, axis, cos_outer, o, d, range, &mut s.cuts);
+                if start > 0.0 && start < cone {
+                    cone_crossings(p, axis, cos_inner, o, d, range, &mut s.cuts);
+                }
+            }
+            Emission::Cosine { normal } => {
+                plane_boundaries(p, normal, o, d, range, &mut s.cuts);
+            }
+        }
+        if self.options.shadows {
+            self.shadow_boundaries(scene, e, o, d, range, &mut s.cuts);
+        }
+        s.cuts.sort_unstable_by(f64::total_cmp);
+        s.cuts.dedup_by(|a, b| *a - *b <= 1e-12 * t_end);
+        s.k.clear();
+        s.k.resize(s.cuts.len(), [f64::NAN; 3]);
+        let mut sum = DVec3::ZERO;
+        for i in 0..s.cuts.len() - 1 {
+            let (ta, tb) = (s.cuts[i], s.cuts[i + 1]);
+            if tb <= ta {
+                continue;
+            }
+            let x = o + d * (0.5 * (ta + tb));
+            let Some(constant) = self.modulation_class(scene, k, x, e) else {
+                continue;
+            };
+            let mut piece = [0.0; 3];
+            for c in 0..k.channels {
+                let g = &glows[c];
+                if g.sigma_t > 0.0 {
+                    for j in [i, i + 1] {
+                        if s.k[j][c].is_nan() {
+                            s.k[j][c] = g.antiderivative(s.cuts[j]);
+                        }
+                    }
+                }
+                piece[c] = g.between_with(ta, tb, s.k[i][c], s.k[i + 1][c]);
+            }
+            let factor = match constant {
+                Some(m) => [m; 3],
+                None => self.weighted_mean(k, &glows, o, d, ta, tb, e),
+            };
+            for c in 0..3 {
+                let from = c.min(k.channels - 1);
+                sum[c] += piece[from] * factor[from];
+            }
+        }
+        sum * e.intensity
+    }
+}
+
+#[derive(Default)]
+struct Scratch {
+    cuts: Vec<f64>,
+    k: Vec<[f64; 3]>,
+}
+
+impl Integrator for Analytic {
+    fn radiance(&self, scene: &Scene, ray: &Ray, sampler: &mut Sampler) -> Rgb {
+        let hit = scene.geometry.intersect(ray, f32::INFINITY);
+        let (surface, t_end) = match hit {
+            Some(hit) => {
+                let s = scene.geometry.surface(ray, hit);
+                (surface_radiance(scene, ray, &s, sampler, scene.medium.as_ref()), hit.t)
+            }
+            None => (scene.settings.background, scene.settings.max_distance),
+        };
+        let Some(medium) = &scene.medium else {
+            return surface;
+        };
+        let through = medium.transmittance(ray.origin, ray.dir, 0.0, t_end);
+        // As raymarch: the medium is integrated up to max_distance at most.
+        let end = t_end.min(scene.settings.max_distance);
+        surface * through + self.in_scattered(scene, medium, ray, end)
+    }
+}
