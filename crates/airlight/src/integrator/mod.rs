@@ -2,10 +2,14 @@
 //! They share one trait; the scene's `[render] integrator` picks one.
 
 mod direct;
+pub mod equiangular;
 mod raymarch;
+mod stochastic;
 
 pub use direct::Direct;
+pub use equiangular::Equiangular;
 pub use raymarch::Raymarch;
+pub use stochastic::{Sampling, Stochastic};
 
 use crate::Rgb;
 use crate::geometry::{Ray, SurfaceHit, offset_origin};
@@ -19,6 +23,13 @@ use serde::Deserialize;
 pub trait Integrator: Send + Sync {
     /// Radiance arriving at the camera along `ray` (one sample).
     fn radiance(&self, scene: &Scene, ray: &Ray, sampler: &mut Sampler) -> Rgb;
+
+    /// Whether camera rays take their film and lens positions from the
+    /// pixel's stratified sequence ([`Sampler::stratified4`] group 0) rather
+    /// than from the sample's random stream.
+    fn stratified(&self) -> bool {
+        false
+    }
 }
 
 /// The integrators a scene or the command line can name.
@@ -83,7 +94,10 @@ pub fn for_scene(scene: &Scene) -> Result<Box<dyn Integrator>, String> {
     match s.integrator {
         IntegratorKind::Direct => Ok(Box::new(Direct)),
         IntegratorKind::Raymarch => Ok(Box::new(Raymarch { steps: s.steps, jitter: s.jitter })),
-        other => Err(format!("the `{other}` integrator is not implemented yet; available: direct, raymarch")),
+        IntegratorKind::Stochastic => Ok(Box::new(Stochastic { sampling: s.sampling, stratify: s.stratify })),
+        other => {
+            Err(format!("the `{other}` integrator is not implemented yet; available: direct, raymarch, stochastic"))
+        }
     }
 }
 

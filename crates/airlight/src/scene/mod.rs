@@ -5,6 +5,7 @@ mod build;
 mod desc;
 mod error;
 mod lights;
+mod sdf;
 
 pub use build::{from_toml_str, load};
 pub use desc::SceneDesc;
@@ -14,7 +15,7 @@ pub use lights::LightCulling;
 use crate::Rgb;
 use crate::camera::Camera;
 use crate::geometry::{Geometry, GeometryBuilder, Shape};
-use crate::integrator::IntegratorKind;
+use crate::integrator::{IntegratorKind, Sampling};
 use crate::light::Light;
 use crate::material::Material;
 use crate::medium::Medium;
@@ -56,6 +57,10 @@ pub struct RenderSettings {
     pub jitter: bool,
     /// Skip lights whose range ends before a point (finite-range falloffs).
     pub cull_lights: bool,
+    /// Stochastic: how the point on the camera segment is drawn.
+    pub sampling: Sampling,
+    /// Stochastic: stratify each pixel's samples (Owen-scrambled Sobol').
+    pub stratify: bool,
 }
 
 impl Default for RenderSettings {
@@ -74,6 +79,8 @@ impl Default for RenderSettings {
             tonemap: Tonemap::Clamp,
             jitter: true,
             cull_lights: true,
+            sampling: Sampling::default(),
+            stratify: true,
         }
     }
 }
@@ -268,6 +275,11 @@ fn bounding_sphere(geometry: &Geometry, lights: &[Light], camera: &Camera) -> (V
                 for p in [corner, corner + edge_u, corner + edge_v, corner + edge_u + edge_v] {
                     grow(p);
                 }
+            }
+            Light::Volume { shape, .. } => {
+                let (lo, hi) = shape.bounds();
+                grow(lo);
+                grow(hi);
             }
             Light::Distant { .. } => {}
         }
