@@ -10,7 +10,7 @@ use glam::Vec3;
 /// Most steps per trace. A ray still short of a surface after this many is
 /// taken to miss: only rays grazing a surface for a long way (a plane seen
 /// edge-on) get there.
-pub const MAX_STEPS: u32 = 256;
+pub const MAX_STEPS: u32 = 512;
 
 /// The hit epsilon at `p`: a trace stops when |d(p)| < 10⁻⁵·(1 + |p|∞). It
 /// grows with |p| because f32 spacing does, and it is ten times smaller than
