@@ -1,9 +1,9 @@
 //! `airlight`: render scenes, check them, compare images.
 
 use airlight::film::{self, Image};
-use airlight::integrator::IntegratorKind;
 use airlight::integrator::analytic::LightQuadrature;
-use airlight::render::{RenderObserver, render_with};
+use airlight::integrator::{IntegratorKind, Sampling};
+use airlight::render::{Progressive, RenderObserver, render_with};
 use airlight::scene::{self, Scene};
 use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
@@ -55,9 +55,20 @@ struct RenderArgs {
     /// Default: airlight.png for the demo, else the scene's name with .png.
     #[arg(short, long = "output", value_name = "OUT")]
     output: Vec<PathBuf>,
-    /// Integrator: direct, raymarch, analytic, path, radiosity (stochastic with the SDF work).
+    /// Integrator: direct, raymarch, analytic, stochastic, path, radiosity.
     #[arg(long)]
     integrator: Option<IntegratorKind>,
+    /// Stochastic: how points on the camera segment are drawn: uniform,
+    /// equiangular or mis.
+    #[arg(long)]
+    sampling: Option<Sampling>,
+    /// Stochastic: independent random samples instead of stratified ones.
+    #[arg(long)]
+    no_stratify: bool,
+    /// Render in passes of 1, 1, 2, 4, ... samples per pixel up to spp,
+    /// rewriting the output after each pass.
+    #[arg(long)]
+    progressive: bool,
     /// Samples per pixel.
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
     spp: Option<u32>,
@@ -196,6 +207,12 @@ fn render(args: RenderArgs) -> Result<(), String> {
     if let Some(v) = args.seed {
         s.seed = v;
     }
+    if let Some(v) = args.sampling {
+        s.sampling = v;
+    }
+    if args.no_stratify {
+        s.stratify = false;
+    }
     if let Some(model) = args.attenuation {
         for light in &mut scene.lights {
             if let Some(a) = light.attenuation() {
@@ -237,24 +254,50 @@ fn render(args: RenderArgs) -> Result<(), String> {
         .map_err(|e| format!("cannot start worker threads: {e}"))?;
     let s = &scene.settings;
     let pixels = s.width as u64 * s.height as u64;
+    let total = if args.progressive { pixels * s.spp as u64 } else { pixels };
     let bar = if args.quiet {
         ProgressBar::hidden()
     } else {
-        ProgressBar::with_draw_target(Some(pixels), ProgressDrawTarget::stderr())
+        ProgressBar::with_draw_target(Some(total), ProgressDrawTarget::stderr())
     };
     if let Ok(style) = ProgressStyle::with_template("{spinner} {msg} [{bar:40}] {percent}% {elapsed} (eta {eta})") {
         bar.set_style(style.progress_chars("=> "));
     }
     bar.set_message(format!("{} {}×{} {} spp", s.integrator, s.width, s.height, s.spp));
-    let progress = |n: u64| bar.inc(n);
-    let observer = RenderObserver { progress: Some(&progress), cancel: None };
+    let write = |image: &Image| -> Result<(), String> {
+        for out in &outputs {
+            image.write(out, s.exposure, s.tonemap).map_err(|e| format!("cannot write `{}`: {e}", out.display()))?;
+        }
+        Ok(())
+    };
     let start = Instant::now();
-    let image = pool.install(|| render_with(&scene, integrator.as_ref(), &observer));
+    if args.progressive {
+        // Each pass rewrites the outputs (atomically), so stopping the
+        // render loses at most the pass under way.
+        let mut progressive = Progressive::new(&scene);
+        while !progressive.finished() {
+            let count = progressive.next_pass_size() as u64;
+            let progress = |n: u64| bar.inc(n * count);
+            let observer = RenderObserver { progress: Some(&progress), cancel: None };
+            pool.install(|| progressive.pass(&scene, integrator.as_ref(), &observer));
+            bar.set_message(format!(
+                "{} {}×{} {}/{} spp",
+                s.integrator,
+                s.width,
+                s.height,
+                progressive.samples(),
+                s.spp
+            ));
+            write(&progressive.image())?;
+        }
+    } else {
+        let progress = |n: u64| bar.inc(n);
+        let observer = RenderObserver { progress: Some(&progress), cancel: None };
+        let image = pool.install(|| render_with(&scene, integrator.as_ref(), &observer));
+        write(&image)?;
+    }
     let elapsed = start.elapsed();
     bar.finish_and_clear();
-    for out in &outputs {
-        image.write(out, s.exposure, s.tonemap).map_err(|e| format!("cannot write `{}`: {e}", out.display()))?;
-    }
     if !args.quiet {
         let names: Vec<String> = outputs.iter().map(|p| p.display().to_string()).collect();
         eprintln!("rendered {}×{} in {:.2} s → {}", s.width, s.height, elapsed.as_secs_f64(), names.join(", "));
@@ -370,6 +413,9 @@ fn info(path: &Path) -> Result<(), String> {
     let s = &scene.settings;
     println!("scene: {}", path.display());
     println!("image: {}×{}, {} spp, integrator {}", s.width, s.height, s.spp, s.integrator);
+    if s.integrator == IntegratorKind::Stochastic {
+        println!("sampling: {}, {}", s.sampling, if s.stratify { "stratified" } else { "independent" });
+    }
     println!(
         "camera: {:?} at {} looking along {}",
         scene.camera.projection, scene.camera.position, scene.camera.forward

@@ -43,6 +43,18 @@ pub fn render(scene: &Scene, observer: &RenderObserver) -> Image {
 /// Renders `scene` with a given integrator: `spp` jittered samples per pixel,
 /// box filtered.
 pub fn render_with(scene: &Scene, integrator: &dyn Integrator, observer: &RenderObserver) -> Image {
+    render_samples(scene, integrator, 0, scene.settings.spp, observer)
+}
+
+/// Renders samples `first .. first + count` of every pixel (sample numbers
+/// count across passes): each pixel is the mean of those samples.
+pub fn render_samples(
+    scene: &Scene,
+    integrator: &dyn Integrator,
+    first: u64,
+    count: u32,
+    observer: &RenderObserver,
+) -> Image {
     let s = &scene.settings;
     let (w, h) = (s.width, s.height);
     let tiles_x = w.div_ceil(TILE);
@@ -59,7 +71,7 @@ pub fn render_with(scene: &Scene, integrator: &dyn Integrator, observer: &Render
             }
             for y in y0..y1 {
                 for x in x0..x1 {
-                    out.push(render_pixel(scene, integrator, x, y, 0));
+                    out.push(pixel_samples(scene, integrator, x, y, first, count));
                 }
             }
             if let Some(progress) = observer.progress {
@@ -88,18 +100,28 @@ pub fn render_with(scene: &Scene, integrator: &dyn Integrator, observer: &Render
 /// anti-aliasing and lens samples, and differ only by what the integrators
 /// compute.
 pub fn render_pixel(scene: &Scene, integrator: &dyn Integrator, x: u32, y: u32, pass: u64) -> Rgb {
+    let spp = scene.settings.spp;
+    pixel_samples(scene, integrator, x, y, pass * spp as u64, spp)
+}
+
+/// The mean of samples `first .. first + count` of one pixel.
+pub fn pixel_samples(scene: &Scene, integrator: &dyn Integrator, x: u32, y: u32, first: u64, count: u32) -> Rgb {
     let s = &scene.settings;
     let index = y as u64 * s.width as u64 + x as u64;
     let mut sum = Rgb::ZERO;
-    for i in 0..s.spp as u64 {
-        let mut sampler = Sampler::for_pixel(s.seed, index, pass * s.spp as u64 + i);
-        let jitter = sampler.next2();
+    for i in 0..count as u64 {
+        let mut sampler = Sampler::for_pixel(s.seed, index, first + i);
+        let (jitter, lens) = if integrator.stratified() {
+            let u = sampler.stratified4(0);
+            (Vec2::new(u[0], u[1]), Vec2::new(u[2], u[3]))
+        } else {
+            (sampler.next2(), sampler.next2())
+        };
         let film = Vec2::new(x as f32, y as f32)
             + match s.filter {
                 PixelFilter::Box => jitter,
                 PixelFilter::Point => Vec2::splat(0.5),
             };
-        let lens = sampler.next2();
         let ray = scene.camera.ray(film, s.width, s.height, lens);
         let l = integrator.radiance(scene, &ray, &mut sampler);
         // One broken sample (NaN, inf) must not spoil the pixel.
@@ -107,5 +129,75 @@ pub fn render_pixel(scene: &Scene, integrator: &dyn Integrator, x: u32, y: u32, 
             sum += l;
         }
     }
-    sum / s.spp as f32
+    sum / count.max(1) as f32
+}
+
+/// Progressive rendering: the scene's `spp` samples in passes of 1, 1, 2,
+/// 4, 8, ... samples per pixel (the last one cut to what is left), each
+/// added to a running sum, so that after every pass the image is the mean of
+/// all samples so far. Pass sizes double so that the pixel's stratified
+/// sequence is always cut at a power of two, where it is best spread, and
+/// the number of passes (and rewrites of the image) grows only as log₂ spp.
+/// The result is a pure function of the scene, as for [`render`], but not
+/// bit for bit the same image: sums are grouped differently.
+pub struct Progressive {
+    width: u32,
+    height: u32,
+    spp: u32,
+    done: u32,
+    sum: Vec<glam::DVec3>,
+}
+
+impl Progressive {
+    pub fn new(scene: &Scene) -> Self {
+        let s = &scene.settings;
+        Progressive {
+            width: s.width,
+            height: s.height,
+            spp: s.spp,
+            done: 0,
+            sum: vec![glam::DVec3::ZERO; s.width as usize * s.height as usize],
+        }
+    }
+
+    /// Samples per pixel rendered so far.
+    pub fn samples(&self) -> u32 {
+        self.done
+    }
+
+    /// Whether all of the scene's samples are in.
+    pub fn finished(&self) -> bool {
+        self.done >= self.spp
+    }
+
+    /// How many samples the next pass renders (0 when finished).
+    pub fn next_pass_size(&self) -> u32 {
+        self.done.max(1).min(self.spp - self.done)
+    }
+
+    /// Renders the next pass and adds it in. Returns false, adding nothing,
+    /// when the observer's cancel flag stopped the pass part way (or when
+    /// everything is already done).
+    pub fn pass(&mut self, scene: &Scene, integrator: &dyn Integrator, observer: &RenderObserver) -> bool {
+        let count = self.next_pass_size();
+        if count == 0 {
+            return false;
+        }
+        let image = render_samples(scene, integrator, self.done as u64, count, observer);
+        if observer.cancel.is_some_and(|c| c.load(Ordering::Relaxed)) {
+            return false;
+        }
+        for (acc, p) in self.sum.iter_mut().zip(&image.pixels) {
+            *acc += p.as_dvec3() * count as f64;
+        }
+        self.done += count;
+        true
+    }
+
+    /// The mean of the samples so far (black before the first pass).
+    pub fn image(&self) -> Image {
+        let n = self.done.max(1) as f64;
+        let pixels = self.sum.iter().map(|s| (*s / n).as_vec3()).collect();
+        Image { width: self.width, height: self.height, pixels }
+    }
 }

@@ -3,6 +3,8 @@
 //! Every pixel draws from its own generator, seeded from (scene seed, pixel,
 //! pass) by a hash, so an image does not depend on which thread rendered what.
 
+pub mod sobol;
+
 use glam::{Vec2, Vec3};
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg32;
@@ -11,6 +13,10 @@ use std::f32::consts::PI;
 /// A per-pixel stream of uniform numbers in [0, 1).
 pub struct Sampler {
     rng: Pcg32,
+    /// The sample's number within its pixel, across passes.
+    sample: u64,
+    /// A key of (seed, pixel) for the pixel's scrambled Sobol' points.
+    pixel_key: u64,
 }
 
 /// SplitMix64's finaliser (Steele, Lea and Flood 2014): a bijective 64-bit mix.
@@ -24,8 +30,20 @@ impl Sampler {
     /// The generator of one sample (`sample`: its number across all passes)
     /// of one pixel of a render with this seed.
     pub fn for_pixel(seed: u64, pixel: u64, sample: u64) -> Self {
-        let key = mix64(mix64(mix64(seed) ^ pixel) ^ sample.wrapping_mul(0x9e37_79b9_7f4a_7c15));
-        Self { rng: Pcg32::seed_from_u64(key) }
+        let pixel_key = mix64(mix64(seed) ^ pixel);
+        let key = mix64(pixel_key ^ sample.wrapping_mul(0x9e37_79b9_7f4a_7c15));
+        Self { rng: Pcg32::seed_from_u64(key), sample, pixel_key }
+    }
+
+    /// Four stratified numbers in [0, 1): this sample's point of the pixel's
+    /// Owen-scrambled Sobol' sequence in `group` (sobol.rs). The pixel's
+    /// samples 0, 1, 2, ... are the points 0, 1, 2, ... of one sequence, so
+    /// any 2^k consecutive samples from 0 are stratified in each coordinate,
+    /// across passes too; each group has its own scramble, so groups are
+    /// independent of each other. Group 0 is the camera's (film and lens).
+    pub fn stratified4(&self, group: u32) -> [f32; 4] {
+        let seed = (mix64(self.pixel_key ^ (group as u64 + 1).wrapping_mul(0xd1b5_4a32_d192_ed03)) >> 32) as u32;
+        sobol::scrambled_sobol4(self.sample as u32, seed)
     }
 
     /// A uniform number in [0, 1). (Not an Iterator: the stream never ends.)

@@ -3,6 +3,7 @@
 //! tested one by one.
 
 use super::Ray;
+use super::sdf::{Sdf, sphere_trace};
 use super::shape::{Shape, box_normal, intersect_box, intersect_quad, intersect_sphere, intersect_triangle};
 use glam::{Affine3A, Mat3, Vec3, Vec3A};
 use obvhs::{Boundable, BvhBuildParams, aabb::Aabb, cwbvh::CwBvh};
@@ -31,6 +32,15 @@ enum Prim {
     },
     /// A sphere or box in its own space.
     Instance(std::boxed::Box<Instance>),
+    /// A signed distance field, sphere traced inside its bounding box.
+    Sdf(std::boxed::Box<SdfPrim>),
+}
+
+#[derive(Clone, Debug)]
+struct SdfPrim {
+    sdf: Sdf,
+    min: Vec3,
+    max: Vec3,
 }
 
 #[derive(Clone, Debug)]
@@ -49,6 +59,16 @@ struct Record {
     material: u32,
     emitter: Option<u32>,
 }
+
+/// An SDF that no box bounds (it holds a plane): traced on its own.
+#[derive(Clone, Debug)]
+struct UnboundedSdf {
+    sdf: Sdf,
+    material: u32,
+}
+
+/// How far an unbounded SDF is traced when the ray has no end.
+const UNBOUNDED_FAR: f32 = 1e5;
 
 #[derive(Clone, Debug)]
 struct PlaneRecord {
@@ -70,6 +90,18 @@ impl Prim {
                 let ld = inst.local_from_world.transform_vector3(d);
                 inst.prim.intersect(lo, ld, tmin, tmax)
             }
+            Prim::Sdf(s) => {
+                // Trace only where the ray is inside the bounding box.
+                let inv = d.recip();
+                let (ta, tb) = ((s.min - o) * inv, (s.max - o) * inv);
+                let near = ta.min(tb).max_element().max(tmin);
+                let far = ta.max(tb).min_element().min(tmax);
+                if near.is_nan() || far.is_nan() || near > far {
+                    return f32::INFINITY;
+                }
+                let t = sphere_trace(&s.sdf, o, d, near, far);
+                if t > tmin && t < tmax { t } else { f32::INFINITY }
+            }
         }
     }
 
@@ -84,6 +116,7 @@ impl Prim {
                 let local = inst.prim.normal(inst.local_from_world.transform_point3(p));
                 (inst.normal_to_world * local).normalize()
             }
+            Prim::Sdf(s) => s.sdf.normal(p),
         }
     }
 
@@ -101,6 +134,7 @@ impl Prim {
             Prim::Box { min, max } => Aabb::new((*min).into(), (*max).into()),
             Prim::Triangle { v0, e1, e2 } => Aabb::from_points(&[(*v0).into(), (*v0 + *e1).into(), (*v0 + *e2).into()]),
             Prim::Instance(inst) => inst.bounds,
+            Prim::Sdf(s) => Aabb::new(s.min.into(), s.max.into()),
         }
     }
 }
@@ -192,6 +226,7 @@ pub struct SurfaceHit {
 pub struct Geometry {
     records: Vec<Record>,
     planes: Vec<PlaneRecord>,
+    unbounded: Vec<UnboundedSdf>,
     /// None when there are few primitives: testing them all is faster.
     bvh: Option<CwBvh>,
     bounds: Option<(Vec3, Vec3)>,
@@ -202,7 +237,11 @@ const LINEAR_LIMIT: usize = 8;
 
 impl std::fmt::Debug for Geometry {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("Geometry").field("primitives", &self.records.len()).field("planes", &self.planes.len()).finish()
+        f.debug_struct("Geometry")
+            .field("primitives", &self.records.len())
+            .field("planes", &self.planes.len())
+            .field("unbounded_sdfs", &self.unbounded.len())
+            .finish()
     }
 }
 
@@ -211,6 +250,7 @@ impl std::fmt::Debug for Geometry {
 pub struct GeometryBuilder {
     records: Vec<Record>,
     planes: Vec<PlaneRecord>,
+    unbounded: Vec<UnboundedSdf>,
 }
 
 impl GeometryBuilder {
@@ -261,16 +301,20 @@ impl GeometryBuilder {
             Shape::Plane { point, normal } => {
                 self.planes.push(PlaneRecord { point: *point, normal: *normal, material })
             }
+            Shape::Sdf(sdf) => match sdf.bounds() {
+                Some((min, max)) => push(Prim::Sdf(std::boxed::Box::new(SdfPrim { sdf: sdf.clone(), min, max }))),
+                None => self.unbounded.push(UnboundedSdf { sdf: sdf.clone(), material }),
+            },
         }
     }
 
     /// Builds the BVH and lays the primitives out in its order.
     pub fn build(self) -> Geometry {
-        let GeometryBuilder { records, planes } = self;
+        let GeometryBuilder { records, planes, unbounded } = self;
         let bounds = records.iter().map(|r| r.prim.bounds()).reduce(|a, b| a.union(&b));
         let bounds = bounds.map(|b| (Vec3::from(b.min), Vec3::from(b.max)));
         if records.len() <= LINEAR_LIMIT {
-            return Geometry { records, planes, bvh: None, bounds };
+            return Geometry { records, planes, unbounded, bvh: None, bounds };
         }
         let mut bvh =
             obvhs::cwbvh::builder::build_cwbvh(&records, BvhBuildParams::medium_build(), &mut Duration::default());
@@ -279,14 +323,15 @@ impl GeometryBuilder {
         for (i, index) in bvh.primitive_indices.iter_mut().enumerate() {
             *index = i as u32;
         }
-        Geometry { records: ordered, planes, bvh: Some(bvh), bounds }
+        Geometry { records: ordered, planes, unbounded, bvh: Some(bvh), bounds }
     }
 }
 
 impl Geometry {
-    /// Number of bounded primitives (triangles count one each) and planes.
+    /// Number of bounded primitives (triangles count one each) and of
+    /// unbounded ones (planes, SDFs holding a plane).
     pub fn primitive_count(&self) -> (usize, usize) {
-        (self.records.len(), self.planes.len())
+        (self.records.len(), self.planes.len() + self.unbounded.len())
     }
 
     /// Bounds of everything but the infinite planes, or None if there is nothing.
@@ -316,14 +361,26 @@ impl Geometry {
                 }
             }
         }
+        self.intersect_unbounded(ray, &mut best);
+        (best.id != u32::MAX).then_some(best)
+    }
+
+    /// Planes and unbounded SDFs, tested one by one after the bounded primitives.
+    fn intersect_unbounded(&self, ray: &Ray, best: &mut Hit) {
         let base = self.records.len() as u32;
         for (i, plane) in self.planes.iter().enumerate() {
             let t = intersect_plane(plane, ray.origin, ray.dir);
             if t > 0.0 && t < best.t {
-                best = Hit { t, id: base + i as u32 };
+                *best = Hit { t, id: base + i as u32 };
             }
         }
-        (best.id != u32::MAX).then_some(best)
+        let base = base + self.planes.len() as u32;
+        for (i, u) in self.unbounded.iter().enumerate() {
+            let t = sphere_trace(&u.sdf, ray.origin, ray.dir, 0.0, best.t.min(UNBOUNDED_FAR));
+            if t > 0.0 && t < best.t {
+                *best = Hit { t, id: base + i as u32 };
+            }
+        }
     }
 
     /// Whether anything lies on the open segment `origin + t·dir`, 0 < t < tmax.
@@ -335,6 +392,12 @@ impl Geometry {
                 return true;
             }
         }
+        for u in &self.unbounded {
+            let t = sphere_trace(&u.sdf, origin, dir, 0.0, tmax.min(UNBOUNDED_FAR));
+            if t > 0.0 && t < tmax {
+                return true;
+            }
+        }
         match &self.bvh {
             Some(bvh) => {
                 let r = bvh_ray(origin, dir, tmax);
@@ -342,6 +405,11 @@ impl Geometry {
             }
             None => self.records.iter().any(|rec| rec.prim.intersect(origin, dir, 0.0, tmax) < tmax),
         }
+    }
+
+    /// Whether any primitive is a signed distance field.
+    pub fn has_sdf(&self) -> bool {
+        self.records.iter().any(|rec| matches!(rec.prim, Prim::Sdf(_)))
     }
 
     /// Every primitive and plane, with the light each is the surface of.
@@ -364,6 +432,9 @@ impl Geometry {
                     // GeometryBuilder::add instances only spheres and boxes.
                     _ => return None,
                 },
+                // No exact shadow boundary: the analytic integrator refuses
+                // shadows in scenes with SDF objects (see has_sdf).
+                Prim::Sdf(_) => return None,
             };
             Some((occluder, rec.emitter))
         });
@@ -382,13 +453,7 @@ impl Geometry {
                 best = Hit { t, id: i as u32 };
             }
         }
-        let base = self.records.len() as u32;
-        for (i, plane) in self.planes.iter().enumerate() {
-            let t = intersect_plane(plane, ray.origin, ray.dir);
-            if t > 0.0 && t < best.t {
-                best = Hit { t, id: base + i as u32 };
-            }
-        }
+        self.intersect_unbounded(ray, &mut best);
         (best.id != u32::MAX).then_some(best)
     }
 
@@ -398,10 +463,13 @@ impl Geometry {
         let index = hit.id as usize;
         match self.records.get(index) {
             Some(rec) => SurfaceHit { p, n: rec.prim.normal(p), material: rec.material, emitter: rec.emitter },
-            None => {
-                let plane = &self.planes[index - self.records.len()];
-                SurfaceHit { p, n: plane.normal, material: plane.material, emitter: None }
-            }
+            None => match self.planes.get(index - self.records.len()) {
+                Some(plane) => SurfaceHit { p, n: plane.normal, material: plane.material, emitter: None },
+                None => {
+                    let u = &self.unbounded[index - self.records.len() - self.planes.len()];
+                    SurfaceHit { p, n: u.sdf.normal(p), material: u.material, emitter: None }
+                }
+            },
         }
     }
 }

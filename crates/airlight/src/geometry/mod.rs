@@ -2,8 +2,10 @@
 
 mod accel;
 mod ray;
+pub mod sdf;
 mod shape;
 
 pub use accel::{Geometry, GeometryBuilder, Hit, Occluder, SurfaceHit, shadow_rays_traced};
 pub use ray::{Ray, offset_origin};
+pub use sdf::Sdf;
 pub use shape::{Shape, intersect_box, intersect_quad, intersect_sphere, intersect_triangle};

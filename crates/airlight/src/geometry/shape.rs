@@ -35,6 +35,8 @@ pub enum Shape {
         positions: Vec<Vec3>,
         triangles: Vec<[u32; 3]>,
     },
+    /// A signed distance field, sphere traced (see `geometry::sdf`).
+    Sdf(super::sdf::Sdf),
     /// A sphere or box under a transform that does not keep it a sphere or an
     /// axis-aligned box (non-uniform scale, rotation).
     Transformed {
@@ -55,6 +57,9 @@ impl Shape {
     }
     pub fn cuboid(min: Vec3, max: Vec3) -> Self {
         Shape::Box { min: min.min(max), max: min.max(max) }
+    }
+    pub fn sdf(sdf: super::sdf::Sdf) -> Self {
+        Shape::Sdf(sdf)
     }
 
     /// The shape under `world_from_local`. Planes, quads and meshes are mapped
@@ -88,6 +93,7 @@ impl Shape {
             Shape::Transformed { shape, world_from_local } => {
                 Shape::Transformed { shape, world_from_local: m * world_from_local }
             }
+            Shape::Sdf(sdf) => Shape::Sdf(sdf.transformed(m)),
             other => Shape::Transformed { shape: std::boxed::Box::new(other), world_from_local: m },
         }
     }

@@ -3,15 +3,19 @@
 
 pub mod analytic;
 mod direct;
+pub mod equiangular;
 pub mod path;
 mod radiosity;
 mod raymarch;
+mod stochastic;
 
 pub use analytic::Analytic;
 pub use direct::Direct;
+pub use equiangular::Equiangular;
 pub use path::PathTracer;
 pub use radiosity::RadiosityIntegrator;
 pub use raymarch::{Raymarch, in_scattered};
+pub use stochastic::{Sampling, Stochastic};
 
 use crate::Rgb;
 use crate::geometry::{Ray, SurfaceHit, offset_origin};
@@ -25,6 +29,13 @@ use serde::Deserialize;
 pub trait Integrator: Send + Sync {
     /// Radiance arriving at the camera along `ray` (one sample).
     fn radiance(&self, scene: &Scene, ray: &Ray, sampler: &mut Sampler) -> Rgb;
+
+    /// Whether camera rays take their film and lens positions from the
+    /// pixel's stratified sequence ([`Sampler::stratified4`] group 0) rather
+    /// than from the sample's random stream.
+    fn stratified(&self) -> bool {
+        false
+    }
 }
 
 /// The integrators a scene or the command line can name.
@@ -92,9 +103,7 @@ pub fn for_scene(scene: &Scene) -> Result<Box<dyn Integrator>, String> {
         IntegratorKind::Path => Ok(Box::new(PathTracer { max_depth: s.max_depth })),
         IntegratorKind::Radiosity => Ok(Box::new(RadiosityIntegrator::new(scene).map_err(|e| e.to_string())?)),
         IntegratorKind::Analytic => Ok(Box::new(Analytic::new(scene, analytic::AnalyticOptions::from_settings(s))?)),
-        other => Err(format!(
-            "the `{other}` integrator is not implemented yet; available: direct, raymarch, analytic, path, radiosity"
-        )),
+        IntegratorKind::Stochastic => Ok(Box::new(Stochastic { sampling: s.sampling, stratify: s.stratify })),
     }
 }
 

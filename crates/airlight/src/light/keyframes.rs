@@ -25,7 +25,7 @@
 //! no keyframes. A still render (`airlight render`) uses the light as written,
 //! without its keyframes.
 
-use super::Light;
+use super::{Light, LightVolume};
 use glam::Vec3;
 
 /// A light's path: positions at times in [0, 1], sorted by time.
@@ -80,6 +80,8 @@ impl Light {
             Light::Sphere { center, .. } => Some(center),
             Light::Quad { corner, edge_u, edge_v, .. } => Some(corner + 0.5 * (edge_u + edge_v)),
             Light::Line { start, end, .. } => Some(0.5 * (start + end)),
+            Light::Volume { shape: LightVolume::Box { min, max }, .. } => Some(0.5 * (min + max)),
+            Light::Volume { shape: LightVolume::Sphere { center, .. }, .. } => Some(center),
             Light::Distant { .. } => None,
         }
     }
@@ -95,6 +97,11 @@ impl Light {
                 let half = 0.5 * (*end - *start);
                 (*start, *end) = (p - half, p + half);
             }
+            Light::Volume { shape: LightVolume::Box { min, max }, .. } => {
+                let half = 0.5 * (*max - *min);
+                (*min, *max) = (p - half, p + half);
+            }
+            Light::Volume { shape: LightVolume::Sphere { center, .. }, .. } => *center = p,
             Light::Distant { .. } => {}
         }
         self

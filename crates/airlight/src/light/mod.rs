@@ -5,6 +5,7 @@
 mod attenuation;
 mod keyframes;
 mod spot;
+mod volume;
 
 pub use attenuation::{
     Attenuation, AttenuationModel, cutoff_falloff, cutoff_range, sphere_falloff, window_rational, window_tan,
@@ -12,10 +13,11 @@ pub use attenuation::{
 };
 pub use keyframes::Keyframes;
 pub use spot::{SpotProfile, spot_falloff};
+pub use volume::{LightVolume, third_dimension};
 
 use crate::Rgb;
 use crate::sampling::{basis, uniform_cone};
-use glam::{Vec2, Vec3};
+use glam::{Vec2, Vec3, Vec3Swizzles};
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Light {
@@ -63,6 +65,12 @@ pub enum Light {
         end: Vec3,
         intensity: Rgb,
     },
+    /// A glowing region of air of total intensity `intensity` (W/sr) spread
+    /// uniformly over it (volume.rs states the units).
+    Volume {
+        shape: LightVolume,
+        intensity: Rgb,
+    },
 }
 
 /// Light arriving at a point from one sampled direction.
@@ -76,7 +84,8 @@ pub struct LightSample {
     /// the irradiance on a surface facing the light (I/d² for a point).
     /// Multiply by BRDF·|cos| (or phase) for the direct-light estimate.
     pub weight: Rgb,
-    /// Solid-angle pdf of `wi`; 0 for delta lights.
+    /// Solid-angle pdf of `wi`; 0 for delta and volume lights (lights that no
+    /// ray can hit).
     pub pdf: f32,
 }
 
@@ -144,11 +153,13 @@ impl Light {
         }
     }
 
-    /// Radiant intensity (W/sr) of a point or spot light, and the
+    /// Radiant intensity (W/sr) of a point, spot or volume light, and the
     /// equivalent π r² L of a sphere light.
     pub fn intensity(&self) -> Rgb {
         match *self {
-            Light::Point { intensity, .. } | Light::Spot { intensity, .. } => intensity,
+            Light::Point { intensity, .. } | Light::Spot { intensity, .. } | Light::Volume { intensity, .. } => {
+                intensity
+            }
             Light::Sphere { radius, radiance, .. } => radiance * (std::f32::consts::PI * radius * radius),
             _ => Rgb::ZERO,
         }
@@ -162,8 +173,53 @@ impl Light {
         Light::Line { start, end, intensity }
     }
 
-    /// Whether the light has no surface to hit or sample by solid angle
-    /// (point, spot, distant, line).
+    /// A glowing box of total intensity I (W/sr).
+    pub fn volume_box(min: Vec3, max: Vec3, intensity: Rgb) -> Self {
+        Light::Volume { shape: LightVolume::Box { min: min.min(max), max: min.max(max) }, intensity }
+    }
+
+    /// A glowing ball of total intensity I (W/sr).
+    pub fn volume_sphere(center: Vec3, radius: f32, intensity: Rgb) -> Self {
+        Light::Volume { shape: LightVolume::Sphere { center, radius }, intensity }
+    }
+
+    /// A point that stands for the light when choosing where to look from:
+    /// equiangular sampling of a ray draws points in proportion to 1/r² from
+    /// it. The light's own point for point and spot lights; a point drawn
+    /// uniformly in the region from `u` for volume lights (the same point
+    /// [`sample3`](Self::sample3) uses with this `u`, so the two form one
+    /// joint sample); the centre of sphere and quad lights; none for a sun.
+    pub fn anchor(&self, u: Vec3) -> Option<Vec3> {
+        match *self {
+            Light::Point { position, .. } | Light::Spot { position, .. } => Some(position),
+            Light::Volume { shape, .. } => Some(shape.sample_point(u)),
+            Light::Sphere { center, .. } => Some(center),
+            Light::Quad { corner, edge_u, edge_v, .. } => Some(corner + 0.5 * (edge_u + edge_v)),
+            Light::Line { start, end, .. } => Some(0.5 * (start + end)),
+            Light::Distant { .. } => None,
+        }
+    }
+
+    /// Like [`sample`](Self::sample) with three uniform numbers: volume
+    /// lights use all three (a point y uniform in the region, pdf 1/V:
+    /// weight = (I/V)/|y − p|² / (1/V) = I/|y − p|²); other lights use the
+    /// first two.
+    pub fn sample3(&self, p: Vec3, u: Vec3) -> Option<LightSample> {
+        match *self {
+            Light::Volume { shape, intensity } => {
+                let to = shape.sample_point(u) - p;
+                let d2 = to.length_squared();
+                if d2 <= 0.0 || !d2.is_finite() {
+                    return None;
+                }
+                let distance = d2.sqrt();
+                Some(LightSample { wi: to / distance, distance, weight: intensity / d2, pdf: 0.0 })
+            }
+            _ => self.sample(p, u.xy()),
+        }
+    }
+
+    /// Whether the light is a point or direction (no area to hit or sample).
     pub fn is_delta(&self) -> bool {
         matches!(self, Light::Point { .. } | Light::Spot { .. } | Light::Distant { .. } | Light::Line { .. })
     }
@@ -226,6 +282,8 @@ impl Light {
                 let pdf = d2 / (area * cos_light);
                 Some(LightSample { wi, distance, weight: radiance / pdf, pdf })
             }
+            // Two numbers given: the third is a hash of them (volume.rs).
+            Light::Volume { .. } => self.sample3(p, u.extend(third_dimension(u))),
         }
     }
 

@@ -90,6 +90,9 @@ pub struct Patch {
 pub fn cut(shape: &Shape, material: u32, object: u32, h: f32, (center, half): (Vec3, f32), out: &mut Vec<Patch>) {
     let start = out.len();
     match shape {
+        // Signed distance fields are not cut into patches (yet): they
+        // neither receive nor pass on bounce light.
+        Shape::Sdf(_) => {}
         Shape::Quad { corner, edge_u, edge_v } => cut_quad(*corner, *edge_u, *edge_v, h, true, out),
         Shape::Plane { point, normal } => {
             let (corner, u, v) = plane_square(*point, *normal, center, half);
@@ -123,6 +126,7 @@ pub fn cut(shape: &Shape, material: u32, object: u32, h: f32, (center, half): (V
 pub fn count(shape: &Shape, h: f32, (center, half): (Vec3, f32)) -> f64 {
     let quad = |u: Vec3, v: Vec3| cells(u.length(), h) as f64 * cells(v.length(), h) as f64;
     match shape {
+        Shape::Sdf(_) => 0.0,
         Shape::Quad { edge_u, edge_v, .. } => 2.0 * quad(*edge_u, *edge_v),
         Shape::Plane { point, normal } => {
             let (_, u, v) = plane_square(*point, *normal, center, half);
@@ -318,6 +322,10 @@ impl Extent {
     /// The extent of `shape`.
     pub fn of(shape: &Shape) -> Extent {
         match shape {
+            Shape::Sdf(sdf) => match sdf.bounds() {
+                Some((lo, hi)) => Extent::Bounds(lo, hi),
+                None => Extent::Bounds(Vec3::ZERO, Vec3::ZERO),
+            },
             Shape::Plane { point, normal } => Extent::Plane { point: *point, normal: *normal },
             Shape::Sphere { center, radius } => Extent::Bounds(center - *radius, center + *radius),
             Shape::Quad { corner, edge_u, edge_v } => {

@@ -35,22 +35,22 @@ pub fn from_toml_str(text: &str, base_dir: Option<&Path>) -> Result<Scene, Scene
     Checker { text, base_dir }.scene(desc)
 }
 
-struct Checker<'a> {
+pub(super) struct Checker<'a> {
     text: &'a str,
     base_dir: Option<&'a Path>,
 }
 
-type Result<T, E = SceneError> = std::result::Result<T, E>;
+pub(super) type Result<T, E = SceneError> = std::result::Result<T, E>;
 
 impl Checker<'_> {
-    fn err(&self, span: Range<usize>, message: impl Into<String>) -> SceneError {
+    pub(super) fn err(&self, span: Range<usize>, message: impl Into<String>) -> SceneError {
         SceneError::at(self.text, span.start, message)
     }
 
     /// An error about `what` (a dotted path such as `objects[2] (sphere).radius`)
     /// in the table at `span`: placed at the field's value when the table
     /// spells the field out, else at the table.
-    fn err_field(&self, span: Range<usize>, what: &str, message: impl Into<String>) -> SceneError {
+    pub(super) fn err_field(&self, span: Range<usize>, what: &str, message: impl Into<String>) -> SceneError {
         let field = what.rsplit('.').next().unwrap_or(what);
         SceneError::at(self.text, self.locate(span.start, field), message)
     }
@@ -58,6 +58,19 @@ impl Checker<'_> {
     /// The offset of `field`'s value in the table starting at `start`, or
     /// `start` when the field is not written there.
     fn locate(&self, start: usize, field: &str) -> usize {
+        // An inline table ({ a = 1, b = 2 }) spells its fields on its first line.
+        let first_line = self.text[start..].split('\n').next().unwrap_or("");
+        let mut from = 0;
+        while let Some(found) = first_line[from..].find(field) {
+            let at = from + found;
+            let before = first_line[..at].trim_end().chars().last();
+            let after = first_line[at + field.len()..].trim_start();
+            if matches!(before, Some('{') | Some(',')) && after.starts_with('=') {
+                let value = after[1..].trim_start();
+                return start + first_line.len() - value.len();
+            }
+            from = at + field.len();
+        }
         let mut offset = start;
         for (i, line) in self.text[start..].split_inclusive('\n').enumerate() {
             let trimmed = line.trim_start();
@@ -169,10 +182,16 @@ impl Checker<'_> {
         if let Some(q) = r.light_quadrature {
             s.light_quadrature = q;
         }
+        if let Some(v) = r.sampling {
+            s.sampling = v;
+        }
+        if let Some(v) = r.stratify {
+            s.stratify = v;
+        }
         Ok(s)
     }
 
-    fn finite(&self, span: Range<usize>, what: &str, v: f32) -> Result<f32> {
+    pub(super) fn finite(&self, span: Range<usize>, what: &str, v: f32) -> Result<f32> {
         if v.is_finite() {
             Ok(v)
         } else {
@@ -180,7 +199,7 @@ impl Checker<'_> {
         }
     }
 
-    fn positive(&self, span: Range<usize>, what: &str, v: f32) -> Result<f32> {
+    pub(super) fn positive(&self, span: Range<usize>, what: &str, v: f32) -> Result<f32> {
         if v.is_finite() && v > 0.0 {
             Ok(v)
         } else {
@@ -188,7 +207,7 @@ impl Checker<'_> {
         }
     }
 
-    fn non_negative(&self, span: Range<usize>, what: &str, v: f32) -> Result<f32> {
+    pub(super) fn non_negative(&self, span: Range<usize>, what: &str, v: f32) -> Result<f32> {
         if v.is_finite() && v >= 0.0 {
             Ok(v)
         } else {
@@ -196,7 +215,7 @@ impl Checker<'_> {
         }
     }
 
-    fn finite3(&self, span: Range<usize>, what: &str, v: Vec3) -> Result<Vec3> {
+    pub(super) fn finite3(&self, span: Range<usize>, what: &str, v: Vec3) -> Result<Vec3> {
         if v.is_finite() { Ok(v) } else { Err(self.err_field(span, what, format!("{what} must be finite, got {v}"))) }
     }
 
@@ -208,7 +227,7 @@ impl Checker<'_> {
         }
     }
 
-    fn nonzero3(&self, span: Range<usize>, what: &str, v: Vec3) -> Result<Vec3> {
+    pub(super) fn nonzero3(&self, span: Range<usize>, what: &str, v: Vec3) -> Result<Vec3> {
         let v = self.finite3(span.clone(), what, v)?;
         if v.length_squared() > 0.0 {
             Ok(v)
@@ -351,7 +370,15 @@ impl Checker<'_> {
         let o = desc.get_ref();
         let kind = format!("{:?}", o.kind).to_lowercase();
         let label = format!("objects[{index}] ({kind})");
-        let fields: [(&str, bool); 10] = [
+        let fields: [(&str, bool); 18] = [
+            ("shape", o.shape.is_some()),
+            ("children", o.children.is_some()),
+            ("blend", o.blend.is_some()),
+            ("a", o.a.is_some()),
+            ("b", o.b.is_some()),
+            ("major_radius", o.major_radius.is_some()),
+            ("minor_radius", o.minor_radius.is_some()),
+            ("rounding", o.rounding.is_some()),
             ("center", o.center.is_some()),
             ("radius", o.radius.is_some()),
             ("point", o.point.is_some()),
@@ -369,8 +396,17 @@ impl Checker<'_> {
             ObjectType::Quad => &["corner", "edge_u", "edge_v"],
             ObjectType::Box => &["min", "max"],
             ObjectType::Mesh => &["file"],
+            // The node's own shape decides (sdf.rs); other types' fields are not for it.
+            ObjectType::Sdf => {
+                let sdf_fields = fields.iter().filter(|(n, _)| !matches!(*n, "corner" | "edge_u" | "edge_v" | "file"));
+                let names: Vec<&str> = sdf_fields.map(|(n, _)| *n).collect();
+                self.check_fields(span.clone(), &label, &kind, &fields, &[], &names)?;
+                &[]
+            }
         };
-        self.check_fields(span.clone(), &label, &kind, &fields, takes, &[])?;
+        if o.kind != ObjectType::Sdf {
+            self.check_fields(span.clone(), &label, &kind, &fields, takes, &[])?;
+        }
         let get = |p: Option<Point>, name: &str| self.finite3(span.clone(), &format!("{label}.{name}"), p.unwrap().0);
         let shape = match o.kind {
             ObjectType::Sphere => {
@@ -404,6 +440,7 @@ impl Checker<'_> {
                 Shape::cuboid(min, max)
             }
             ObjectType::Mesh => self.mesh(&label, o.file.as_ref().unwrap())?,
+            ObjectType::Sdf => Shape::Sdf(self.sdf_object(span.clone(), &label, o)?),
         };
         let transform = self.transform(span.clone(), &label, o)?;
         let material = match &o.material {
@@ -426,7 +463,7 @@ impl Checker<'_> {
 
     /// Checks that an object or light has every field its type needs and
     /// none that belongs to another type.
-    fn check_fields(
+    pub(super) fn check_fields(
         &self,
         span: Range<usize>,
         label: &str,
@@ -455,10 +492,22 @@ impl Checker<'_> {
 
     /// T·Rz·Ry·Rx·S: scale, then rotate about X, Y, Z (degrees), then translate.
     fn transform(&self, span: Range<usize>, label: &str, o: &ObjectDesc) -> Result<Affine3A> {
+        self.transform_parts(span, label, o.translate, o.rotate, o.scale)
+    }
+
+    /// The transform of `translate`, `rotate` (degrees) and `scale`, each optional.
+    pub(super) fn transform_parts(
+        &self,
+        span: Range<usize>,
+        label: &str,
+        translate: Option<Point>,
+        rotate: Option<Point>,
+        scale: Option<Triple>,
+    ) -> Result<Affine3A> {
         let translate =
-            self.finite3(span.clone(), &format!("{label}.translate"), o.translate.map_or(Vec3::ZERO, |p| p.0))?;
-        let rotate = self.finite3(span.clone(), &format!("{label}.rotate"), o.rotate.map_or(Vec3::ZERO, |p| p.0))?;
-        let scale = self.finite3(span.clone(), &format!("{label}.scale"), o.scale.map_or(Vec3::ONE, |p| p.0))?;
+            self.finite3(span.clone(), &format!("{label}.translate"), translate.map_or(Vec3::ZERO, |p| p.0))?;
+        let rotate = self.finite3(span.clone(), &format!("{label}.rotate"), rotate.map_or(Vec3::ZERO, |p| p.0))?;
+        let scale = self.finite3(span.clone(), &format!("{label}.scale"), scale.map_or(Vec3::ONE, |p| p.0))?;
         if scale.cmpeq(Vec3::ZERO).any() {
             return Err(self.err_field(
                 span,
@@ -511,7 +560,10 @@ impl Checker<'_> {
         let l = desc.get_ref();
         let kind = format!("{:?}", l.kind).to_lowercase();
         let label = format!("lights[{index}] ({kind})");
-        let fields: [(&str, bool); 19] = [
+        let fields: [(&str, bool); 22] = [
+            ("min", l.min.is_some()),
+            ("max", l.max.is_some()),
+            ("volume", l.volume.is_some()),
             ("position", l.position.is_some()),
             ("intensity", l.intensity.is_some()),
             ("direction", l.direction.is_some()),
@@ -591,8 +643,25 @@ impl Checker<'_> {
                 let d = self.nonzero3(span.clone(), &at("direction"), l.direction.unwrap().0)?;
                 return Ok(Light::distant(d, power(l.irradiance, "irradiance")?));
             }
+            LightType::Sphere if l.volume == Some(true) => {
+                check(&["center", "radius", "intensity"], &["volume"])?;
+                let radius = self.positive(span.clone(), &at("radius"), l.radius.unwrap())?;
+                return Ok(Light::volume_sphere(point(l.center, "center")?, radius, power(l.intensity, "intensity")?));
+            }
+            LightType::Box => {
+                check(&["min", "max", "intensity"], &[])?;
+                let (min, max) = (point(l.min, "min")?, point(l.max, "max")?);
+                if !min.cmplt(max).all() {
+                    return Err(self.err_field(
+                        span,
+                        "max",
+                        format!("{label}: min must be less than max on every axis, got min {min} max {max}"),
+                    ));
+                }
+                return Ok(Light::volume_box(min, max, power(l.intensity, "intensity")?));
+            }
             LightType::Sphere => {
-                check(&["center", "radius", "radiance"], &FALLOFF)?;
+                check(&["center", "radius", "radiance"], &[&FALLOFF[..], &["volume"]].concat())?;
                 let radius = self.positive(span.clone(), &at("radius"), l.radius.unwrap())?;
                 Light::sphere(point(l.center, "center")?, radius, power(l.radiance, "radiance")?)
             }

@@ -2,8 +2,8 @@
 //! schema (version 1)". Unknown keys are errors. `build.rs` checks the values
 //! and turns them into a [`Scene`](super::Scene).
 
-use crate::integrator::IntegratorKind;
 use crate::integrator::analytic::LightQuadrature;
+use crate::integrator::{IntegratorKind, Sampling};
 use crate::light::{AttenuationModel, SpotProfile};
 use crate::scene::Tonemap;
 use glam::Vec3;
@@ -57,6 +57,10 @@ pub struct RenderDesc {
     pub shadows: Option<bool>,
     pub light_steps: Option<Spanned<i64>>,
     pub light_quadrature: Option<LightQuadrature>,
+    /// Stochastic: uniform | equiangular | mis.
+    pub sampling: Option<Sampling>,
+    /// Stochastic: stratify each pixel's samples.
+    pub stratify: Option<bool>,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
@@ -142,6 +146,7 @@ pub enum ObjectType {
     Quad,
     Box,
     Mesh,
+    Sdf,
 }
 
 /// One `[[objects]]` table. Fields are optional here; which ones a type
@@ -165,6 +170,58 @@ pub struct ObjectDesc {
     pub translate: Option<Point>,
     pub rotate: Option<Point>,
     pub scale: Option<Triple>,
+    // Signed distance fields (`type = "sdf"`): the root node's fields, as in
+    // [`SdfNodeDesc`].
+    pub shape: Option<SdfShape>,
+    pub children: Option<Vec<Spanned<SdfNodeDesc>>>,
+    pub blend: Option<f32>,
+    pub a: Option<Point>,
+    pub b: Option<Point>,
+    pub major_radius: Option<f32>,
+    pub minor_radius: Option<f32>,
+    pub rounding: Option<f32>,
+}
+
+/// The kinds of node of a signed distance field.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SdfShape {
+    Sphere,
+    Box,
+    RoundBox,
+    Torus,
+    Capsule,
+    Cylinder,
+    Plane,
+    Union,
+    Intersection,
+    Subtraction,
+    SmoothUnion,
+}
+
+/// One node of a signed distance field: a primitive with its parameters or
+/// a combination with `children`, each placed by its own translate, rotate,
+/// scale. Which fields a shape takes is checked when the scene is built.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SdfNodeDesc {
+    pub shape: SdfShape,
+    pub center: Option<Point>,
+    pub radius: Option<f32>,
+    pub min: Option<Point>,
+    pub max: Option<Point>,
+    pub point: Option<Point>,
+    pub normal: Option<Point>,
+    pub a: Option<Point>,
+    pub b: Option<Point>,
+    pub major_radius: Option<f32>,
+    pub minor_radius: Option<f32>,
+    pub rounding: Option<f32>,
+    pub blend: Option<f32>,
+    pub children: Option<Vec<Spanned<SdfNodeDesc>>>,
+    pub translate: Option<Point>,
+    pub rotate: Option<Point>,
+    pub scale: Option<Triple>,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
@@ -176,6 +233,8 @@ pub enum LightType {
     Sphere,
     Quad,
     Line,
+    /// A volume light filling a box.
+    Box,
 }
 
 /// One `[[lights]]` table; as for objects, the fields a type needs are
@@ -207,6 +266,12 @@ pub struct LightDesc {
     pub cutoff: Option<f32>,
     /// d_max: how far from its surface a finite-range falloff reaches.
     pub range: Option<f32>,
+    /// Box light: its corners.
+    pub min: Option<Point>,
+    pub max: Option<Point>,
+    /// Sphere light: a glowing ball (volume light of `intensity`) instead of
+    /// a surface of `radiance`.
+    pub volume: Option<bool>,
     /// The path the light moves along in animations; see
     /// [`crate::light::Keyframes`].
     pub keyframes: Option<Spanned<Vec<Spanned<KeyframeDesc>>>>,

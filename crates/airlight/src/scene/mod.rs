@@ -5,6 +5,7 @@ mod build;
 mod desc;
 mod error;
 mod lights;
+mod sdf;
 
 pub use build::{from_toml_str, load};
 pub use desc::SceneDesc;
@@ -14,8 +15,8 @@ pub use lights::LightCulling;
 use crate::Rgb;
 use crate::camera::Camera;
 use crate::geometry::{Geometry, GeometryBuilder, Shape};
-use crate::integrator::IntegratorKind;
 use crate::integrator::analytic::LightQuadrature;
+use crate::integrator::{IntegratorKind, Sampling};
 use crate::light::{Keyframes, Light};
 use crate::material::Material;
 use crate::medium::Medium;
@@ -72,6 +73,10 @@ pub struct RenderSettings {
     pub link_threshold: f32,
     /// Skip lights whose range ends before a point (finite-range falloffs).
     pub cull_lights: bool,
+    /// Stochastic: how the point on the camera segment is drawn.
+    pub sampling: Sampling,
+    /// Stochastic: stratify each pixel's samples (Owen-scrambled Sobol').
+    pub stratify: bool,
     /// How a pixel gathers its samples.
     pub filter: PixelFilter,
 }
@@ -111,6 +116,8 @@ impl Default for RenderSettings {
             shadows: false,
             light_steps: 16,
             light_quadrature: LightQuadrature::Gauss,
+            sampling: Sampling::default(),
+            stratify: true,
         }
     }
 }
@@ -383,6 +390,11 @@ fn bounding_sphere(geometry: &Geometry, lights: &[Light], camera: &Camera) -> (V
             Light::Line { start, end, .. } => {
                 grow(start);
                 grow(end);
+            }
+            Light::Volume { shape, .. } => {
+                let (lo, hi) = shape.bounds();
+                grow(lo);
+                grow(hi);
             }
             Light::Distant { .. } => {}
         }

@@ -157,6 +157,11 @@ impl Analytic {
     /// must be homogeneous, and distant lights have no closed form here.
     pub fn new(scene: &Scene, options: AnalyticOptions) -> Result<Analytic, String> {
         let in_medium = scene.medium.as_ref().is_some_and(|m| m.sigma_s != Rgb::ZERO);
+        if options.shadows && scene.geometry.has_sdf() {
+            return Err("the analytic integrator finds no exact shadow boundaries for SDF objects: \
+                        use raymarch or stochastic, or render without shadows"
+                .into());
+        }
         if let Some(m) = &scene.medium
             && let Density::Height { .. } = m.density
         {
@@ -228,6 +233,11 @@ impl Analytic {
                         intensity: radiance.as_dvec3() * n.length(),
                         light: index,
                     });
+                }
+                Light::Volume { .. } => {
+                    return Err(format!(
+                        "the analytic integrator has no closed form for a volume light (lights[{i}]): use stochastic"
+                    ));
                 }
                 Light::Distant { .. } => {
                     if in_medium {
