@@ -100,7 +100,7 @@ pub fn for_scene(scene: &Scene) -> Result<Box<dyn Integrator>, String> {
     match s.integrator {
         IntegratorKind::Direct => Ok(Box::new(Direct)),
         IntegratorKind::Raymarch => Ok(Box::new(Raymarch { steps: s.steps, jitter: s.jitter })),
-        IntegratorKind::Path => Ok(Box::new(PathTracer { max_depth: s.max_depth })),
+        IntegratorKind::Path => Ok(Box::new(PathTracer::new(s.max_depth))),
         IntegratorKind::Radiosity => Ok(Box::new(RadiosityIntegrator::new(scene).map_err(|e| e.to_string())?)),
         IntegratorKind::Analytic => Ok(Box::new(Analytic::new(scene, analytic::AnalyticOptions::from_settings(s))?)),
         IntegratorKind::Stochastic => Ok(Box::new(Stochastic { sampling: s.sampling, stratify: s.stratify })),
