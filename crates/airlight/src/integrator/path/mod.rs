@@ -38,16 +38,17 @@ impl PathTracer {
     }
 }
 
-/// Where light scatters: a surface or a point in the medium.
-enum Vertex {
+/// Where light scatters: a surface or a point in the medium (with its
+/// place on an equiangularly sampled segment, if any).
+enum Vertex<'a> {
     Surface { p: Vec3, n: Vec3, material: u32 },
-    Medium { p: Vec3 },
+    Medium { p: Vec3, along: Option<Along<'a>> },
 }
 
-impl Vertex {
+impl Vertex<'_> {
     fn p(&self) -> Vec3 {
         match *self {
-            Vertex::Surface { p, .. } | Vertex::Medium { p } => p,
+            Vertex::Surface { p, .. } | Vertex::Medium { p, .. } => p,
         }
     }
 }
@@ -105,17 +106,8 @@ impl Integrator for PathTracer {
                         }
                         let p = ray.at(c.t);
                         let wo = -ray.dir;
-                        l += beta
-                            * direct_light(
-                                scene,
-                                m.into(),
-                                &Vertex::Medium { p },
-                                wo,
-                                r_u,
-                                hero,
-                                along.as_ref(),
-                                sampler,
-                            );
+                        let vertex = Vertex::Medium { p, along };
+                        l += beta * direct_light(scene, m.into(), &vertex, wo, r_u, hero, sampler);
                         // Phase sampling: its weight p/pdf is 1.
                         let cos = sample_henyey_greenstein_cos(m.g, sampler.next());
                         let sin = (1.0 - cos * cos).max(0.0).sqrt();
@@ -185,7 +177,7 @@ impl Integrator for PathTracer {
             let material = &scene.materials[surface.material as usize];
             let wo = -ray.dir;
             let vertex = Vertex::Surface { p: surface.p, n: surface.n, material: surface.material };
-            l += beta * direct_light(scene, medium, &vertex, wo, r_u, hero, None, sampler);
+            l += beta * direct_light(scene, medium, &vertex, wo, r_u, hero, sampler);
             let Some(bs) = material.sample(surface.p, surface.n, wo, sampler.next2(), sampler.next()) else {
                 return l;
             };

@@ -90,7 +90,7 @@ pub(super) fn equiangular_light(
         let p = segment.ray.at(t);
         let Some(ls) = light.sample(p, keyed2(key, 2 * index as u64 + 1)) else { continue };
         let phase = medium.phase(wo, ls.wi);
-        if !(pdf > 0.0) || phase <= 0.0 || ls.weight == Rgb::ZERO {
+        if pdf <= 0.0 || !pdf.is_finite() || phase <= 0.0 || ls.weight == Rgb::ZERO {
             continue;
         }
         if scene.geometry.occluded(p, ls.wi, scene.shadow_span(p, p, ls.wi, ls.distance)) {
@@ -119,7 +119,7 @@ pub(super) fn equiangular_applies(medium: &Medium) -> bool {
 /// it, with a shadow ray and the medium's transmittance, weighted by the
 /// balance heuristic against sampling the BRDF or phase function (area
 /// lights) or against equiangular sampling of the segment (delta lights,
-/// when `along` gives the collision's place on it). Returns the
+/// when the medium vertex knows its place on it). Returns the
 /// contribution to be multiplied by the path weight β.
 pub(super) fn direct_light(
     scene: &Scene,
@@ -128,10 +128,13 @@ pub(super) fn direct_light(
     wo: Vec3,
     r_p: Rgb,
     hero: usize,
-    along: Option<&Along>,
     sampler: &mut Sampler,
 ) -> Rgb {
     let p = vertex.p();
+    let along = match vertex {
+        Vertex::Medium { along, .. } => along.as_ref(),
+        Vertex::Surface { .. } => None,
+    };
     let key = sampler.next_key();
     let mut total = Rgb::ZERO;
     scene.for_each_light_at(p, |index, light| {
@@ -142,7 +145,7 @@ pub(super) fn direct_light(
                 let f = m.brdf(p, n, wo, ls.wi) * ls.wi.dot(n).abs();
                 (f, m.pdf(p, n, wo, ls.wi), offset_origin(p, n, ls.wi))
             }
-            Vertex::Medium { p } => {
+            Vertex::Medium { p, .. } => {
                 let phase = medium.map_or(0.0, |m| m.phase(wo, ls.wi));
                 (Rgb::splat(phase), phase, p)
             }
