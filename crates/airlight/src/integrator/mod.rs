@@ -136,8 +136,7 @@ pub(crate) fn surface_radiance(
         }
         let origin = offset_origin(surface.p, surface.n, sample.wi);
         let distance = scene.light_distance(sample.distance);
-        if scene.geometry.occluded(origin, sample.wi, scene.shadow_span(surface.p, origin, sample.wi, sample.distance))
-        {
+        if !scene.light_visible(surface.p, origin, sample.wi, sample.distance) {
             return;
         }
         let mut contribution = f * sample.weight * cos;

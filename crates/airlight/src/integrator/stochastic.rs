@@ -127,7 +127,7 @@ impl Integrator for Stochastic {
                 continue;
             }
             let distance = scene.light_distance(sample.distance);
-            if scene.geometry.occluded(x, sample.wi, distance * (1.0 - 1e-4)) {
+            if !scene.light_visible(x, x, sample.wi, sample.distance) {
                 continue;
             }
             let to_eye = medium.transmittance(ray.origin, ray.dir, 0.0, t);

@@ -93,7 +93,7 @@ pub(super) fn equiangular_light(
         if pdf <= 0.0 || !pdf.is_finite() || phase <= 0.0 || ls.weight == Rgb::ZERO {
             continue;
         }
-        if scene.geometry.occluded(p, ls.wi, scene.shadow_span(p, p, ls.wi, ls.distance)) {
+        if !scene.light_visible(p, p, ls.wi, ls.distance) {
             continue;
         }
         let t_light = medium.transmittance(p, ls.wi, 0.0, scene.light_distance(ls.distance));
@@ -154,7 +154,7 @@ pub(super) fn direct_light(
             return;
         }
         let distance = scene.light_distance(ls.distance);
-        if scene.geometry.occluded(origin, ls.wi, scene.shadow_span(p, origin, ls.wi, ls.distance)) {
+        if !scene.light_visible(p, origin, ls.wi, ls.distance) {
             return;
         }
         let (mut t_ray, mut r_l, mut r_u) = (Rgb::ONE, Rgb::ONE, Rgb::ONE);
