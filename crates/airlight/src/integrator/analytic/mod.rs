@@ -47,6 +47,7 @@ mod lights;
 mod modulation;
 mod quadrature;
 mod shadows;
+mod table;
 
 pub use boundaries::{
     box_boundaries, box_edges, cone_crossings, edge_boundaries, plane_boundaries, polygon_boundaries, quadratic_roots,
@@ -56,6 +57,7 @@ pub use closed_form::{Glow, P_FLOOR, glow_extinction, glow_vacuum, glow_vacuum_f
 pub use expint::{Complex, scaled_e1};
 pub use lights::sphere_factor;
 pub use quadrature::Rule;
+pub use table::{TABLE_ERROR, im_s as im_s_tabulated, sun_f_tabulated};
 
 use lights::Extended;
 use modulation::MediumConsts;
@@ -338,7 +340,7 @@ impl Analytic {
                 if g.sigma_t > 0.0 {
                     for j in [i, i + 1] {
                         if s.k[j][c].is_nan() {
-                            s.k[j][c] = g.antiderivative(s.cuts[j]);
+                            s.k[j][c] = g.antiderivative_tabulated(s.cuts[j]);
                         }
                     }
                 }
