@@ -40,6 +40,7 @@
 //! isotropic scattering when the extinction along the different paths from
 //! its surface is neglected, O(σt R)).
 
+mod blockers;
 mod boundaries;
 mod closed_form;
 mod expint;
@@ -59,14 +60,15 @@ pub use lights::sphere_factor;
 pub use quadrature::Rule;
 pub use table::{TABLE_ERROR, im_s as im_s_tabulated, sun_f_tabulated};
 
+use blockers::Blocker;
 use lights::Extended;
 use modulation::MediumConsts;
-use shadows::visible;
+use shadows::{in_intervals, visible};
 
 use super::{Integrator, surface_radiance};
 use crate::Rgb;
-use crate::geometry::{Occluder, Ray};
-use crate::light::{Light, SpotProfile};
+use crate::geometry::Ray;
+use crate::light::{AttenuationModel, Light, SpotProfile};
 use crate::medium::{Density, Medium};
 use crate::sampling::Sampler;
 use crate::scene::{RenderSettings, Scene};
@@ -144,6 +146,8 @@ pub struct Analytic {
     extended: Vec<Extended>,
     /// The rule over each piece of a line or quad light, on [0, 1].
     rule: Rule,
+    /// The occluders other than triangles, in f64 (for shadows).
+    blockers: Vec<Blocker>,
     /// Whether some occluder is a triangle: shadow boundaries on meshes are
     /// bracketed by a coarse march and refined by bisection.
     meshes: bool,
@@ -183,6 +187,15 @@ impl Analytic {
         let mut extended = Vec::new();
         for (i, light) in scene.lights.iter().enumerate() {
             let index = i as u32;
+            if let Some(a) = light.attenuation()
+                && a.model != AttenuationModel::Physical
+            {
+                return Err(format!(
+                    "the analytic integrator integrates the physical inverse-square falloff only; lights[{i}] \
+                     uses the {:?} attenuation model: use raymarch",
+                    a.model
+                ));
+            }
             let point = |position: Vec3, intensity: Rgb, emission, gap| PointEmitter {
                 position: position.as_dvec3(),
                 intensity: intensity.as_dvec3(),
@@ -253,8 +266,8 @@ impl Analytic {
         }
         emitters.retain(|e| e.intensity != DVec3::ZERO);
         extended.retain(|e| e.intensity() != DVec3::ZERO);
-        let meshes = scene.geometry.occluders().any(|(o, _)| matches!(o, Occluder::Triangle { .. }));
-        Ok(Analytic { options, emitters, extended, rule, meshes })
+        let (blockers, meshes) = blockers::blockers(&scene.geometry);
+        Ok(Analytic { options, emitters, extended, rule, blockers, meshes })
     }
 
     /// Single-scattered radiance along `ray` over [0, t_end] from all lights.
@@ -265,25 +278,35 @@ impl Analytic {
         let o = ray.origin.as_dvec3();
         let d = ray.dir.as_dvec3().normalize();
         let consts = MediumConsts::new(medium);
-        let mut scratch = Scratch::default();
-        let mut total = DVec3::ZERO;
         let t_end = t_end as f64;
-        for e in &self.emitters {
-            total += self.emitter_light(scene, &consts, o, d, t_end, e, &mut scratch);
+        // Buffers reused across rays on this thread (a fresh set if nested).
+        thread_local! {
+            static SCRATCH: std::cell::RefCell<Scratch> = std::cell::RefCell::new(Scratch::default());
         }
-        for x in &self.extended {
-            let mut each = |e: &PointEmitter| {
-                total += self.emitter_light(scene, &consts, o, d, t_end, e, &mut scratch);
-            };
-            match *x {
-                Extended::Line { start, end, intensity, light } => {
-                    self.line_pieces(o, d, t_end, (start, end), intensity, light, 0, &mut each)
-                }
-                Extended::Quad { corner, edge_u, edge_v, normal, intensity, light } => {
-                    self.quad_pieces(o, d, t_end, (corner, edge_u, edge_v), normal, intensity, light, 0, &mut each)
+        let run = |scratch: &mut Scratch| {
+            let mut total = DVec3::ZERO;
+            for e in &self.emitters {
+                total += self.emitter_light(scene, &consts, o, d, t_end, e, scratch);
+            }
+            for x in &self.extended {
+                let mut each = |e: &PointEmitter| {
+                    total += self.emitter_light(scene, &consts, o, d, t_end, e, scratch);
+                };
+                match *x {
+                    Extended::Line { start, end, intensity, light } => {
+                        self.line_pieces(o, d, t_end, (start, end), intensity, light, 0, &mut each)
+                    }
+                    Extended::Quad { corner, edge_u, edge_v, normal, intensity, light } => {
+                        self.quad_pieces(o, d, t_end, (corner, edge_u, edge_v), normal, intensity, light, 0, &mut each)
+                    }
                 }
             }
-        }
+            total
+        };
+        let total = SCRATCH.with(|s| match s.try_borrow_mut() {
+            Ok(mut s) => run(&mut s),
+            Err(_) => run(&mut Scratch::default()),
+        });
         (total * medium.sigma_s.as_dvec3()).as_vec3()
     }
 
@@ -300,7 +323,9 @@ impl Analytic {
         s: &mut Scratch,
     ) -> DVec3 {
         let p = e.position;
-        let glows: [Glow; 3] = std::array::from_fn(|c| Glow::new(k.sigma_t[c], p, o, d, t_end));
+        let first = Glow::new(k.sigma_t[0], p, o, d, t_end);
+        let glows: [Glow; 3] =
+            std::array::from_fn(|c| if c < k.channels { Glow { sigma_t: k.sigma_t[c], ..first } } else { first });
         let range = (0.0, t_end);
         s.cuts.clear();
         s.cuts.push(0.0);
@@ -317,7 +342,16 @@ impl Analytic {
                 plane_boundaries(p, normal, o, d, range, &mut s.cuts);
             }
         }
-        if self.options.shadows {
+        let exact_shadows = self.options.shadows && !self.meshes;
+        if exact_shadows {
+            self.shadow_intervals(e, o, d, range, &mut s.cands, &mut s.shadow);
+            if s.shadow.first().is_some_and(|&(a, b)| a <= 0.0 && b >= t_end) {
+                return DVec3::ZERO;
+            }
+            for &(a, b) in &s.shadow {
+                s.cuts.extend([a, b].into_iter().filter(|&t| t > 0.0 && t < t_end));
+            }
+        } else if self.options.shadows {
             self.shadow_boundaries(scene, e, o, d, range, &mut s.cuts);
         }
         s.cuts.sort_unstable_by(f64::total_cmp);
@@ -330,10 +364,16 @@ impl Analytic {
             if tb <= ta {
                 continue;
             }
-            let x = o + d * (0.5 * (ta + tb));
-            let Some(constant) = self.modulation_class(scene, k, x, e) else {
+            let tm = 0.5 * (ta + tb);
+            let x = o + d * tm;
+            let Some(constant) = self.modulation_class(k, x, e) else {
                 continue;
             };
+            if exact_shadows && in_intervals(&s.shadow, tm)
+                || self.options.shadows && self.meshes && !visible(scene, x, e)
+            {
+                continue;
+            }
             let mut piece = [0.0; 3];
             for c in 0..k.channels {
                 let g = &glows[c];
@@ -362,6 +402,10 @@ impl Analytic {
 #[derive(Default)]
 struct Scratch {
     cuts: Vec<f64>,
+    /// One occluder's candidate shadow boundaries.
+    cands: Vec<f64>,
+    /// The ray's shadowed intervals for the current emitter.
+    shadow: Vec<(f64, f64)>,
     k: Vec<[f64; 3]>,
 }
 

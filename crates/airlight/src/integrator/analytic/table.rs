@@ -89,7 +89,8 @@ fn lagrange4(f: f64) -> [f64; 4] {
 /// second node.
 #[inline]
 fn stencil(x: f64, n: usize) -> (usize, f64) {
-    let i = (x.floor() as isize).clamp(1, n as isize - 3) as usize;
+    // x ≥ 0, so truncation is the floor.
+    let i = (x as usize).clamp(1, n - 3);
     (i - 1, x - i as f64)
 }
 
