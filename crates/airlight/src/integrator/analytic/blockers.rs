@@ -108,13 +108,18 @@ impl Blocker {
     /// o + t d, t in [t₀, t₁], can meet the bounding sphere: the triangle
     /// (light, o + t₀ d, o + t₁ d) that those segments sweep lies farther
     /// than the radius from the centre, in its plane's normal direction or
-    /// beyond one of its edges. Conservative (never true when the sphere
-    /// meets the triangle).
+    /// beyond one of its edges; for a plane, when the triangle lies on one
+    /// side of it. Conservative (never true when the occluder meets the
+    /// triangle).
     pub fn misses(&self, light: DVec3, o: DVec3, d: DVec3, (t0, t1): (f64, f64)) -> bool {
-        if self.radius.is_infinite() {
-            return false;
-        }
         let (a, b) = (o + d * t0, o + d * t1);
+        if let Shape::Plane { point, normal } = self.shape {
+            // The triangle lies on the light's side of the plane (a
+            // half-space is convex).
+            let side = |x: DVec3| normal.dot(x - point);
+            let s = side(light);
+            return (s > 0.0 && side(a) > 0.0 && side(b) > 0.0) || (s < 0.0 && side(a) < 0.0 && side(b) < 0.0);
+        }
         let tri = [light, a, b];
         let n = (a - light).cross(b - light);
         let n2 = n.length_squared();

@@ -16,7 +16,11 @@
 //! - when phase·m is constant (isotropic phase, inside a spot's inner cone,
 //!   lit), the integral is exact: [`glow_vacuum`] (the seed's atan form) for
 //!   σt = 0, [`Glow`] (Sun et al.'s F through the complex exponential
-//!   integral) for σt > 0;
+//!   integral) for σt > 0. The renderer reads Im S = Im e^z E₁(z), the one
+//!   special function in it, from a table (as Sun et al. tabulate F; see
+//!   table.rs: relative error ≤ [`TABLE_ERROR`] = 2e-7), once per piece
+//!   boundary for all three channels when σt is grey; the public closed
+//!   forms ([`Glow::between`], [`glow_extinction`], [`sun_f`]) stay exact;
 //! - otherwise (Henyey–Greenstein with g ≠ 0, a spot's soft edge, a quad
 //!   light's cosine) the exact integral of the attenuation alone is
 //!   multiplied by the mean of phase·m weighted by that attenuation, taken by
@@ -34,11 +38,26 @@
 //! point spacings (each point then shows its own glow), so per ray a piece
 //! of the light that the ray passes close to is halved (line, up to 8
 //! times) or quartered (quad, up to 3 times) and the rule applied on each
-//! part: an adaptive composite rule, which leaves far rays with n points. A sphere light of radiance L and
+//! part: an adaptive composite rule, which leaves far rays with n points.
+//! A sphere light of radiance L and
 //! radius R is, for points outside it, exactly a point light of intensity
 //! πR²L at its centre (a Lambertian sphere's radiant intensity; exact for
 //! isotropic scattering when the extinction along the different paths from
 //! its surface is neglected, O(σt R)).
+//!
+//! Shadows (`shadows = true`): without meshes, each occluder's shadow along
+//! the ray is one interval, found exactly from its boundaries and cheap
+//! segment–shape tests, with no shadow rays (blockers.rs, shadows.rs);
+//! occluders whose bounding sphere cannot touch the triangle swept by the
+//! ray's shadow segments are skipped. With meshes, boundaries are bracketed
+//! by a coarse march and bisection and each piece takes one shadow ray.
+//!
+//! What it refuses, with a message naming the light or object and the
+//! integrator to use instead ([`Analytic::new`]): height fog (the closed form
+//! needs a homogeneous medium), volume lights, distant lights in a medium,
+//! lights with a real-time attenuation model other than `physical` (the
+//! closed form integrates 1/r²), and SDF objects when `shadows` is on (they
+//! have no exact shadow boundaries; without shadows they only end rays).
 
 mod blockers;
 mod boundaries;
@@ -159,8 +178,10 @@ pub const MESH_MARCH_STEPS: usize = 64;
 const MODULATED_POINTS: usize = 16;
 
 impl Analytic {
-    /// The integrator for `scene`, or why it cannot render it: the medium
-    /// must be homogeneous, and distant lights have no closed form here.
+    /// The integrator for `scene`, or why it cannot render it (a message for
+    /// the user, never a panic): height fog, volume lights, distant lights
+    /// in a medium, non-physical attenuation models, and SDF objects with
+    /// shadows are refused (see the module documentation).
     pub fn new(scene: &Scene, options: AnalyticOptions) -> Result<Analytic, String> {
         let in_medium = scene.medium.as_ref().is_some_and(|m| m.sigma_s != Rgb::ZERO);
         if options.shadows && scene.geometry.has_sdf() {

@@ -19,16 +19,18 @@
 //! for small ρ and as sin φ / ρ for large ρ (A&S 5.1.11 and 5.1.51), so the
 //! table holds the smooth, O(1) quantity
 //!
-//!   N(τ, q) = Im S(z) · (1 + ρ) / τ,   τ = tan(φ/2) = u / (x + ρ),   q = ln ρ,
+//!   N(τ, q) = Im S(z) · (1 + ρ) / τ,   τ = tan(φ/2) = u / (x + ρ),   q = ρ^{1/4},
 //!
-//! on a uniform grid in τ ∈ [0, 1] and q ∈ [ln ρ_min, ln ρ_max], read by
-//! tensor-product 4-point (cubic) Lagrange interpolation. τ is algebraic in
-//! (x, u), so a look-up costs one square root, one logarithm and 16 reads.
-//! At τ = 0 (real z) N is the limit 2 (1 + ρ)(1 − ρ S(ρ)) (from
-//! S′(z) = S(z) − 1/z). Outside the table: ρ < ρ_min by the exact
-//! series ([`scaled_e1`]), which needs few terms there; ρ > ρ_max by the
-//! asymptotic series S(z) ~ Σ_k (−1)^k k! / z^{k+1} (A&S 5.1.51), truncated
-//! after 9 terms (relative error below 9!/ρ⁹ ≈ 1e-11 at ρ = 64).
+//! on a uniform grid in τ ∈ [0, 1] and q ∈ [0, 64^{1/4}], read by
+//! tensor-product 4-point (cubic) Lagrange interpolation. Both coordinates
+//! are algebraic in (x, u), so a look-up costs three square roots, two
+//! divisions and 16 reads. q = ρ^{1/4} spreads the nodes toward small ρ, as
+//! a logarithm would, while keeping ρ ln ρ = 4 q⁴ ln q smooth enough for
+//! cubics (its fourth derivative grows only as ln q). At τ = 0 (real z) N is
+//! the limit 2 (1 + ρ)(1 − ρ S(ρ)) (from S′(z) = S(z) − 1/z); at ρ = 0 it is
+//! 2 atan(τ)/τ (Im S = φ). For ρ > 64, the asymptotic series
+//! S(z) ~ Σ_k (−1)^k k! / z^{k+1} (A&S 5.1.51), truncated after 9 terms
+//! (relative error below 9!/ρ⁹ ≈ 1e-11 at ρ = 64).
 //!
 //! Accuracy against the exact [`scaled_e1`] is tested below (and F against
 //! [`super::sun_f`]): see `TABLE_ERROR`.
@@ -38,12 +40,11 @@ use std::sync::OnceLock;
 
 /// Grid nodes in τ = tan(φ/2) over [0, 1].
 const NT: usize = 49;
-/// Grid nodes in q = ln ρ over [Q_MIN, Q_MAX].
+/// Grid nodes in q = ρ^{1/4} over [0, Q_MAX].
 const NQ: usize = 193;
-/// ρ_min = e^Q_MIN ≈ 1e-4.
-const Q_MIN: f64 = -9.2;
-/// ρ_max = e^Q_MAX ≈ 64.
-const Q_MAX: f64 = 4.16;
+/// ρ_max = Q_MAX⁴ = 64.
+const Q_MAX: f64 = 2.828_427_124_746_190_3;
+const RHO_MAX: f64 = 64.0;
 
 /// The worst relative error of [`im_s`] against the exact Im S found by the
 /// tests (random points over the quadrant, ρ from 1e-6 to 1e4): a bound the
@@ -59,10 +60,13 @@ fn table() -> &'static Table {
     TABLE.get_or_init(|| {
         let mut values = vec![0.0; NT * NQ];
         for j in 0..NQ {
-            let rho = (Q_MIN + (Q_MAX - Q_MIN) * j as f64 / (NQ - 1) as f64).exp();
+            let rho = (Q_MAX * j as f64 / (NQ - 1) as f64).powi(4);
             for i in 0..NT {
                 let tau = i as f64 / (NT - 1) as f64;
-                values[j * NT + i] = if i == 0 {
+                values[j * NT + i] = if j == 0 {
+                    // ρ = 0: Im S = φ = 2 atan τ.
+                    if i == 0 { 2.0 } else { 2.0 * tau.atan() / tau }
+                } else if i == 0 {
                     let s = scaled_e1(Complex::new(rho, 0.0)).re;
                     2.0 * (1.0 + rho) * (1.0 - rho * s)
                 } else {
@@ -100,17 +104,14 @@ fn stencil(x: f64, n: usize) -> (usize, f64) {
 #[inline]
 pub fn im_s(x: f64, u: f64) -> f64 {
     let rho = (x * x + u * u).sqrt();
-    if rho > Q_MAX.exp() {
+    if rho > RHO_MAX {
         return asymptotic_im_s(x, u, rho);
     }
-    let q = rho.ln();
-    if q < Q_MIN {
-        return scaled_e1(Complex::new(x, -u)).im;
-    }
+    let q = rho.sqrt().sqrt();
     let tau = u / (x + rho);
     let t = table();
     let (i0, fi) = stencil(tau * (NT - 1) as f64, NT);
-    let (j0, fj) = stencil((q - Q_MIN) * ((NQ - 1) as f64 / (Q_MAX - Q_MIN)), NQ);
+    let (j0, fj) = stencil(q * ((NQ - 1) as f64 / Q_MAX), NQ);
     let (wi, wj) = (lagrange4(fi), lagrange4(fj));
     let mut n = 0.0;
     for (b, wb) in wj.iter().enumerate() {
