@@ -211,10 +211,17 @@ impl Analytic {
             if let Some(a) = light.attenuation()
                 && a.model != AttenuationModel::Physical
             {
+                let name = match a.model {
+                    AttenuationModel::Physical => "physical",
+                    AttenuationModel::Sphere => "sphere",
+                    AttenuationModel::Cutoff => "cutoff",
+                    AttenuationModel::WindowTan => "window_tan",
+                    AttenuationModel::WindowRational => "window_rational",
+                    AttenuationModel::WindowUe4 => "window_ue4",
+                };
                 return Err(format!(
                     "the analytic integrator integrates the physical inverse-square falloff only; lights[{i}] \
-                     uses the {:?} attenuation model: use raymarch",
-                    a.model
+                     has attenuation = \"{name}\": use raymarch, or attenuation = \"physical\""
                 ));
             }
             let point = |position: Vec3, intensity: Rgb, emission, gap| PointEmitter {
