@@ -110,7 +110,7 @@ pub fn for_scene(scene: &Scene) -> Result<Box<dyn Integrator>, String> {
 /// Radiance leaving a surface toward `-ray.dir`: its emission plus direct
 /// light from every light, one sample per area light, with shadow rays. In a
 /// medium, light arriving from each light is attenuated on its way.
-pub(crate) fn surface_radiance(
+pub fn surface_radiance(
     scene: &Scene,
     ray: &Ray,
     surface: &SurfaceHit,
