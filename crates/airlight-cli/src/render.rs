@@ -96,6 +96,9 @@ pub fn render(args: RenderArgs) -> Result<(), String> {
     {
         return Err(format!("cannot write `{}`: the variance is written as .exr", v.display()));
     }
+    if args.variance.is_some() && scene.settings.spp < 2 {
+        return Err("--variance: a variance needs at least 2 samples per pixel (--spp)".into());
+    }
     if args.frames.is_some() && !scene.is_animated() {
         return Err("--frames: the scene has no light with keyframes to animate".into());
     }

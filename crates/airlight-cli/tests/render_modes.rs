@@ -86,6 +86,7 @@ fn bad_convergence_options_are_refused_before_rendering() {
         &["render", "--target-error", "-0.1"],
         &["render", "--target-error", "nan"],
         &["render", "--variance", "var.png"],
+        &["render", "--variance", "var.exr", "--spp", "1"],
         &["render", "--frames", "0"],
     ] {
         let out = airlight(dir.path(), args);
