@@ -20,6 +20,9 @@ use crate::sampling::Sampler;
 use crate::scene::{LightCulling, Scene};
 use std::f32::consts::FRAC_1_PI;
 
+mod cache;
+pub use cache::FirstSample;
+
 /// March steps per ray when the medium has no closed form (height fog).
 pub const FALLBACK_STEPS: u32 = 16;
 
@@ -92,7 +95,15 @@ impl Integrator for Preview<'_> {
             }
             None => (scene.settings.background, scene.settings.max_distance),
         };
-        let Some(medium) = medium else {
+        self.through_medium(scene, ray, surface, t_end, sampler)
+    }
+}
+
+impl Preview<'_> {
+    /// `surface` radiance from distance `t_end` along `ray`, attenuated by
+    /// the medium, plus the glow in front of it.
+    fn through_medium(&self, scene: &Scene, ray: &Ray, surface: Rgb, t_end: f32, sampler: &mut Sampler) -> Rgb {
+        let Some(medium) = &scene.medium else {
             return surface;
         };
         let through = medium.transmittance(ray.origin, ray.dir, 0.0, t_end);
