@@ -37,7 +37,7 @@ pub fn run(engine: &mut Engine, start: &Start, options: &Options) -> Result<(), 
         .map_err(|e| format!("cannot open a window ({e}); without a display, use --headless"))?;
     // Caps the polling rate when idle; rendering is slower than this anyway.
     window.set_target_fps(120);
-    let mut fly = FlyCamera::from_camera(&start.camera, (0.4 * engine.scene.bounds_radius).max(0.1));
+    let mut fly = FlyCamera::from_camera(&start.camera, (0.15 * engine.scene.bounds_radius).max(0.05));
     let mut lights = start.lights.clone();
     let movable: Vec<usize> = (0..lights.len()).filter(|&i| lights[i].position().is_some()).collect();
     let mut selected = 0;
