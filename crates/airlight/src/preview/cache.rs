@@ -20,12 +20,8 @@ use crate::sampling::Sampler;
 use crate::scene::{PixelFilter, Scene};
 use glam::Vec2;
 use rayon::prelude::*;
+use std::cell::RefCell;
 use std::f32::consts::FRAC_1_PI;
-
-/// Most patches whose weights a pixel keeps; a pixel with more (not seen
-/// on the scenes at hand, where about ten fall in the kernel) asks the
-/// solution's lookup every frame instead.
-const MAX_WEIGHTS: usize = 48;
 
 /// One pixel's camera ray and what it meets among the objects.
 #[derive(Clone, Copy)]
@@ -36,8 +32,7 @@ struct Texel {
     t: f32,
     /// The diffuse albedo at the hit, times 1/π.
     albedo: Rgb,
-    /// Lookup weights: `weights[start..start + len]`, times `scale`;
-    /// `len == u32::MAX` when the pixel has too many.
+    /// Lookup weights: `weights[start..start + len]`, times `scale`.
     start: u32,
     len: u32,
     scale: f32,
@@ -123,13 +118,9 @@ impl FirstSample {
                         if let Some(solution) = solution {
                             let n = if surface.n.dot(ray.dir) <= 0.0 { surface.n } else { -surface.n };
                             texel.start = weights.len() as u32;
-                            match lookup_weights(solution, surface.p, n) {
-                                Some(acc) if acc.overflow => texel.len = u32::MAX,
-                                Some(acc) => {
-                                    weights.extend_from_slice(&acc.items[..acc.n as usize]);
-                                    (texel.len, texel.scale) = (acc.n as u32, acc.scale);
-                                }
-                                None => {}
+                            if let Some(scale) = lookup_weights(solution, surface.p, n, &mut weights) {
+                                texel.len = weights.len() as u32 - texel.start;
+                                texel.scale = scale;
                             }
                         }
                     }
@@ -142,12 +133,7 @@ impl FirstSample {
         self.weights.clear();
         for (texels, weights) in rows {
             let base = self.weights.len() as u32;
-            self.texels.extend(texels.into_iter().map(|mut t| {
-                if t.len != u32::MAX {
-                    t.start += base;
-                }
-                t
-            }));
+            self.texels.extend(texels.into_iter().map(|t| Texel { start: t.start + base, ..t }));
             self.weights.extend(weights);
         }
         self.key = Some(key(scene));
@@ -176,10 +162,7 @@ impl FirstSample {
                 Some(s) => {
                     let mut l = surface_radiance(scene, ray, s, &mut sampler, medium);
                     if let Some(solution) = solution {
-                        let e = if texel.len == u32::MAX {
-                            let n = if s.n.dot(ray.dir) <= 0.0 { s.n } else { -s.n };
-                            solution.irradiance_at(s.p, n)
-                        } else if texel.len > 0 {
+                        let e = if texel.len > 0 {
                             let e = solution.indirect_irradiance();
                             let ws = &self.weights[texel.start as usize..(texel.start + texel.len) as usize];
                             Some(ws.iter().fold(Rgb::ZERO, |sum, &(i, w)| sum + e[i as usize] * w) * texel.scale)
@@ -225,69 +208,68 @@ fn light_surfaces(scene: &Scene) -> Geometry {
     g.build()
 }
 
-/// Patch indices and raw weights of one lookup: collected by running the
-/// solution's own interpolation over this type instead of over colours, so
-/// that the weights are the lookup's, whatever its kernel. The lookup
-/// computes (Σᵢ value(i)·wᵢ)·(1/Σ wᵢ): a single `value(i)` times a weight
-/// keeps the weight, a sum concatenates, and a factor on a sum is the final
-/// normalisation, kept in `scale`.
+/// One term, or the running sum, of the lookup's kernel average, run over
+/// this type instead of over colours to learn the lookup's patches and
+/// weights, whatever its kernel. The lookup computes
+/// (Σᵢ value(i)·wᵢ)·(1/Σ wᵢ): a single `value(i)` times a weight keeps the
+/// weight, adding it to the sum appends (patch, weight) to `sink`, and a
+/// factor on the sum is the final normalisation, kept in `scale`. Small and
+/// `Copy`, so the lookup's by-value arithmetic costs nothing.
 #[derive(Clone, Copy)]
-pub struct Weights {
-    items: [(u32, f32); MAX_WEIGHTS],
-    n: u8,
-    summed: bool,
-    overflow: bool,
+struct Term<'a> {
+    sink: Option<&'a RefCell<Vec<(u32, f32)>>>,
+    /// A single term's patch and weight (before it joins the sum).
+    single: Option<(u32, f32)>,
     scale: f32,
 }
 
-impl Default for Weights {
+impl Default for Term<'_> {
+    /// The empty sum.
     fn default() -> Self {
-        Weights { items: [(0, 0.0); MAX_WEIGHTS], n: 0, summed: false, overflow: false, scale: 1.0 }
+        Term { sink: None, single: None, scale: 1.0 }
     }
 }
 
-impl Weights {
-    fn one(i: usize) -> Self {
-        let mut w = Weights { n: 1, ..Weights::default() };
-        w.items[0] = (i as u32, 1.0);
-        w
-    }
-}
-
-impl std::ops::Mul<f32> for Weights {
-    type Output = Weights;
-    fn mul(mut self, f: f32) -> Weights {
-        if self.summed {
-            self.scale *= f;
-        } else {
-            for item in &mut self.items[..self.n as usize] {
-                item.1 *= f;
-            }
+impl std::ops::Mul<f32> for Term<'_> {
+    type Output = Self;
+    fn mul(mut self, f: f32) -> Self {
+        match &mut self.single {
+            Some((_, w)) => *w *= f,
+            None => self.scale *= f,
         }
         self
     }
 }
 
-impl std::ops::Add for Weights {
-    type Output = Weights;
-    fn add(mut self, other: Weights) -> Weights {
-        for &item in &other.items[..other.n as usize] {
-            if (self.n as usize) < MAX_WEIGHTS {
-                self.items[self.n as usize] = item;
-                self.n += 1;
-            } else {
-                self.overflow = true;
-            }
+impl std::ops::Add for Term<'_> {
+    type Output = Self;
+    fn add(self, other: Self) -> Self {
+        let sink = self.sink.or(other.sink);
+        if let (Some(sink), Some(item)) = (sink, other.single) {
+            sink.borrow_mut().push(item);
         }
-        self.overflow |= other.overflow;
-        self.summed = true;
-        self
+        Term { sink, single: None, scale: self.scale }
     }
 }
 
-/// The lookup's patches and weights at `p` (see [`Weights`]).
-fn lookup_weights(solution: &Radiosity, p: glam::Vec3, n: glam::Vec3) -> Option<Weights> {
-    solution.lookup().interpolate(solution.patches(), p, n, Weights::one)
+/// Appends the lookup's (patch, weight) pairs at `p` to `out` and returns
+/// the normalisation factor, or None (nothing appended) where no patch is near.
+fn lookup_weights(solution: &Radiosity, p: glam::Vec3, n: glam::Vec3, out: &mut Vec<(u32, f32)>) -> Option<f32> {
+    let sink = RefCell::new(std::mem::take(out));
+    let before = sink.borrow().len();
+    let scale = solution
+        .lookup()
+        .interpolate(solution.patches(), p, n, |i| Term {
+            sink: Some(&sink),
+            single: Some((i as u32, 1.0)),
+            scale: 1.0,
+        })
+        .map(|t| t.scale);
+    *out = sink.into_inner();
+    if scale.is_none() {
+        out.truncate(before);
+    }
+    scale
 }
 
 #[cfg(test)]
@@ -336,12 +318,11 @@ mod tests {
     }
 
     #[test]
-    fn weights_follow_the_lookups_sum_and_normalisation() {
-        let w = (Weights::default() + Weights::one(3) * 0.5 + Weights::one(7) * 0.25) * 4.0;
-        assert_eq!(&w.items[..w.n as usize], &[(3, 0.5), (7, 0.25)]);
-        assert_eq!(w.scale, 4.0);
-        assert!(!w.overflow);
-        let many = (0..MAX_WEIGHTS + 1).fold(Weights::default(), |acc, i| acc + Weights::one(i) * 1.0);
-        assert!(many.overflow);
+    fn terms_follow_the_lookups_sum_and_normalisation() {
+        let sink = RefCell::new(Vec::new());
+        let one = |i: u32| Term { sink: Some(&sink), single: Some((i, 1.0)), scale: 1.0 };
+        let sum = (Term::default() + one(3) * 0.5 + one(7) * 0.25) * 4.0;
+        assert_eq!(sum.scale, 4.0);
+        assert_eq!(sink.borrow().as_slice(), &[(3, 0.5), (7, 0.25)]);
     }
 }
