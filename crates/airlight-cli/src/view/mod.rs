@@ -8,8 +8,11 @@
 //! The library stays free of window code; what the viewer needed of it is
 //! [`airlight::preview`].
 
+// Without the window, parts of the frame loop that only keys reach go unused.
+#[cfg_attr(not(feature = "viewer"), allow(dead_code))]
 pub mod engine;
 pub mod headless;
+#[cfg(any(feature = "viewer", test))]
 pub mod input;
 pub mod path;
 #[cfg(feature = "viewer")]
