@@ -157,11 +157,12 @@ fn a_light_moved_toward_a_wall_brightens_it_and_leaves_the_other_room_unchanged(
     // over the wall, seen at a slant, by about half.
     assert!(after > 1.3 * before, "the wall the light nears: mean {before} → {after}");
 
-    // The other room: lit the same. Not bit for bit: the radiosity
-    // hierarchy links some clusters across the wall with a sampled
-    // visibility, which lets about 0.1% of the change through (measured
-    // 5.8e-4 at most on a mean of 0.53), against a change of half on the
-    // wall the light nears.
+    // The other room: lit the same. Not bit for bit: the radiosity solution
+    // lets about 0.1% of the change through the wall, spread over the whole
+    // room (measured 5.8e-4 at most on a mean of 0.53), against a change of
+    // half on the wall the light nears; likely its links between clusters
+    // that straddle the wall, whose visibility is sampled (not traced
+    // further here).
     let other = mean(&first, 1);
     assert!(other > 0.01, "the other room is lit: {other}");
     let mut worst = 0.0f32;
