@@ -10,8 +10,9 @@ sphere, box and plane objects, diffuse materials, point, spot, quad and
 sphere lights, a homogeneous medium filling space), renders it with
 Mitsuba's `volpath` (or `path` in vacuum), renders it with `airlight render
 --integrator path` at the same size and sample count, and prints
-`airlight compare` of the two, plus the noise floor: Airlight against
-itself with another seed.
+`airlight compare` of the two, plus the noise floors: each renderer
+against itself with another seed, from which each image's own error and
+the time each renderer needs for the same error follow (error ∝ 1/√time).
 
 Conventions matched (../shared/DESIGN.md): intensities in W/sr, radiance for
 area lights; a pixel is the box-filtered mean; Mitsuba's max_depth counts
@@ -220,6 +221,9 @@ def main():
         mitsuba_seconds = time.time() - start
         ref = os.path.join(args.out, f"{name}.mitsuba.exr")
         mi.util.write_bitmap(ref, image, write_async=False)
+        # Mitsuba again with another seed: its own noise, for equal-error times.
+        ref_other = os.path.join(args.out, f"{name}.mitsuba-seed1.exr")
+        mi.util.write_bitmap(ref_other, mi.render(scene, spp=args.spp, seed=1), write_async=False)
         ours = os.path.join(args.out, f"{name}.airlight.exr")
         other = os.path.join(args.out, f"{name}.airlight-seed1.exr")
         start = time.time()
@@ -228,10 +232,18 @@ def main():
         airlight("render", path, "--integrator", "path", "--spp", str(args.spp), "--seed", "1", "-o", other, "--quiet")
         vs = airlight("compare", ours, ref, "--map", os.path.join(args.out, f"{name}.error.png"))
         noise = airlight("compare", ours, other)
+        mitsuba_noise = airlight("compare", ref, ref_other)
         field = lambda text, key: float([l for l in text.splitlines() if l.startswith(key + ":")][0].split()[1])
         print(f"{name}: {args.spp} spp; Mitsuba {args.variant} {mitsuba_seconds:.1f} s, Airlight {airlight_seconds:.1f} s")
         print(f"  airlight vs mitsuba: rel_rmse {field(vs, 'rel_rmse'):.4f}  rmse {field(vs, 'rmse'):.5f}  mae {field(vs, 'mae'):.5f}")
         print(f"  airlight vs airlight (seed 1): rel_rmse {field(noise, 'rel_rmse'):.4f}  rmse {field(noise, 'rmse'):.5f}  mae {field(noise, 'mae'):.5f}")
+        print(f"  mitsuba vs mitsuba (seed 1): rel_rmse {field(mitsuba_noise, 'rel_rmse'):.4f}")
+        # Each image's own error is the seed-to-seed difference over √2; error
+        # falls as 1/√time, so equal error costs time · error².
+        e_a, e_m = field(noise, "rel_rmse") / math.sqrt(2), field(mitsuba_noise, "rel_rmse") / math.sqrt(2)
+        if e_a > 0:
+            speedup = (mitsuba_seconds * e_m**2) / (airlight_seconds * e_a**2)
+            print(f"  own error: airlight {e_a:.4f}, mitsuba {e_m:.4f}; Airlight faster at equal error by {speedup:.1f}x")
         means = lambda key: [float(x) for x in [l for l in vs.splitlines() if l.startswith(key + ":")][0].split()[1:]]
         ma, mm = means("mean_a"), means("mean_b")
         print(f"  image means: airlight {fmt(ma)}  mitsuba {fmt(mm)}  ratio {fmt([a / b if b else float('nan') for a, b in zip(ma, mm)])}")

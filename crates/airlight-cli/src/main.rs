@@ -1,17 +1,15 @@
 //! `airlight`: render scenes, check them, compare images.
 
 use airlight::film::{self, Image};
-use airlight::integrator::analytic::LightQuadrature;
-use airlight::integrator::{IntegratorKind, Sampling};
-use airlight::render::{Progressive, RenderObserver, render_with};
+use airlight::integrator::IntegratorKind;
+use airlight::render::{RenderObserver, render_with};
 use airlight::scene::{self, Scene};
 use clap::{Parser, Subcommand};
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
-use std::time::Instant;
 
 mod plot;
+mod render;
 mod view;
 
 /// The built-in demo scene: spheres on a checker floor under a spot light in fog.
@@ -27,7 +25,7 @@ struct Cli {
 #[derive(Subcommand)]
 enum Command {
     /// Render a scene file (with none: the built-in demo scene) to an image.
-    Render(RenderArgs),
+    Render(render::RenderArgs),
     /// Check a scene file and print what it holds.
     Info { scene: PathBuf },
     /// Plot the attenuation curves of a light of given radius, intensity and
@@ -49,61 +47,6 @@ enum Command {
         #[arg(long, value_name = "OUT.png")]
         map: Option<PathBuf>,
     },
-}
-
-#[derive(clap::Args)]
-struct RenderArgs {
-    /// Scene file (TOML). Without one, the built-in demo scene.
-    scene: Option<PathBuf>,
-    /// Output image, .png or .exr; may be given more than once.
-    /// Default: airlight.png for the demo, else the scene's name with .png.
-    #[arg(short, long = "output", value_name = "OUT")]
-    output: Vec<PathBuf>,
-    /// Integrator: direct, raymarch, analytic, stochastic, path, radiosity.
-    #[arg(long)]
-    integrator: Option<IntegratorKind>,
-    /// Stochastic: how points on the camera segment are drawn: uniform,
-    /// equiangular or mis.
-    #[arg(long)]
-    sampling: Option<Sampling>,
-    /// Stochastic: independent random samples instead of stratified ones.
-    #[arg(long)]
-    no_stratify: bool,
-    /// Render in passes of 1, 1, 2, 4, ... samples per pixel up to spp,
-    /// rewriting the output after each pass.
-    #[arg(long)]
-    progressive: bool,
-    /// Samples per pixel.
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
-    spp: Option<u32>,
-    /// March samples per ray.
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
-    steps: Option<u32>,
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
-    width: Option<u32>,
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
-    height: Option<u32>,
-    #[arg(long)]
-    seed: Option<u64>,
-    /// Falloff for every point, spot and sphere light: physical, sphere,
-    /// cutoff, window_tan, window_rational, window_ue4 (each keeps its cutoff).
-    #[arg(long, value_parser = parse_attenuation)]
-    attenuation: Option<airlight::light::AttenuationModel>,
-    /// analytic: volumetric shadows (the lit intervals of each ray).
-    #[arg(long)]
-    shadows: bool,
-    /// analytic: points per dimension over line and quad lights.
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=4096))]
-    light_steps: Option<u32>,
-    /// analytic: gauss (Gauss–Legendre) or uniform (the seed's stepping) over lights.
-    #[arg(long, value_parser = parse_light_quadrature)]
-    light_quadrature: Option<LightQuadrature>,
-    /// Worker threads (default: all cores). The image does not depend on it.
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
-    threads: Option<u32>,
-    /// No progress bar or summary.
-    #[arg(long, short)]
-    quiet: bool,
 }
 
 #[derive(clap::Args)]
@@ -160,7 +103,7 @@ struct GiArgs {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
-        Command::Render(args) => render(args),
+        Command::Render(args) => render::render(args),
         Command::Info { scene } => info(&scene),
         Command::Compare { image, reference, map } => compare(&image, &reference, map.as_deref()),
         Command::Attenuation(args) => attenuation(args),
@@ -176,138 +119,12 @@ fn main() -> ExitCode {
     }
 }
 
-fn parse_light_quadrature(s: &str) -> Result<LightQuadrature, String> {
-    match s {
-        "gauss" => Ok(LightQuadrature::Gauss),
-        "uniform" => Ok(LightQuadrature::Uniform),
-        _ => Err(format!("unknown light quadrature `{s}`; expected gauss or uniform")),
-    }
-}
-
+/// The scene at `path`, or the built-in demo scene.
 fn load(path: Option<&Path>) -> Result<Scene, String> {
     match path {
         Some(path) => scene::load(path).map_err(|e| e.to_string()),
         None => scene::from_toml_str(DEMO_SCENE, None).map_err(|e| format!("built-in demo scene: {e}")),
     }
-}
-
-fn render(args: RenderArgs) -> Result<(), String> {
-    let mut scene = load(args.scene.as_deref())?;
-    let s = &mut scene.settings;
-    if let Some(v) = args.integrator {
-        s.integrator = v;
-    }
-    if let Some(v) = args.spp {
-        s.spp = v;
-    }
-    if let Some(v) = args.steps {
-        s.steps = v;
-    }
-    if let Some(v) = args.width {
-        s.width = v;
-    }
-    if let Some(v) = args.height {
-        s.height = v;
-    }
-    if let Some(v) = args.seed {
-        s.seed = v;
-    }
-    if let Some(v) = args.sampling {
-        s.sampling = v;
-    }
-    if args.no_stratify {
-        s.stratify = false;
-    }
-    if let Some(model) = args.attenuation {
-        for light in &mut scene.lights {
-            if let Some(a) = light.attenuation() {
-                let a = a.with_model(model).map_err(|e| format!("--attenuation: {e}"))?;
-                *light = light.with_attenuation(a);
-            }
-        }
-        scene.light_culling = airlight::scene::LightCulling::new(&scene.lights);
-    }
-    if args.shadows {
-        s.shadows = true;
-    }
-    if let Some(v) = args.light_steps {
-        s.light_steps = v;
-    }
-    if let Some(v) = args.light_quadrature {
-        s.light_quadrature = v;
-    }
-    let outputs = if args.output.is_empty() {
-        vec![match &args.scene {
-            Some(path) => PathBuf::from(path.file_stem().unwrap_or_default()).with_extension("png"),
-            None => PathBuf::from("airlight.png"),
-        }]
-    } else {
-        args.output
-    };
-    for out in &outputs {
-        match out.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref() {
-            Some("png" | "exr") => {}
-            _ => {
-                return Err(format!("cannot write `{}`: the output must end in .png or .exr", out.display()));
-            }
-        }
-    }
-    let integrator = airlight::integrator::for_scene(&scene)?;
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(args.threads.unwrap_or(0) as usize)
-        .build()
-        .map_err(|e| format!("cannot start worker threads: {e}"))?;
-    let s = &scene.settings;
-    let pixels = s.width as u64 * s.height as u64;
-    let total = if args.progressive { pixels * s.spp as u64 } else { pixels };
-    let bar = if args.quiet {
-        ProgressBar::hidden()
-    } else {
-        ProgressBar::with_draw_target(Some(total), ProgressDrawTarget::stderr())
-    };
-    if let Ok(style) = ProgressStyle::with_template("{spinner} {msg} [{bar:40}] {percent}% {elapsed} (eta {eta})") {
-        bar.set_style(style.progress_chars("=> "));
-    }
-    bar.set_message(format!("{} {}×{} {} spp", s.integrator, s.width, s.height, s.spp));
-    let write = |image: &Image| -> Result<(), String> {
-        for out in &outputs {
-            image.write(out, s.exposure, s.tonemap).map_err(|e| format!("cannot write `{}`: {e}", out.display()))?;
-        }
-        Ok(())
-    };
-    let start = Instant::now();
-    if args.progressive {
-        // Each pass rewrites the outputs (atomically), so stopping the
-        // render loses at most the pass under way.
-        let mut progressive = Progressive::new(&scene);
-        while !progressive.finished() {
-            let count = progressive.next_pass_size() as u64;
-            let progress = |n: u64| bar.inc(n * count);
-            let observer = RenderObserver { progress: Some(&progress), cancel: None };
-            pool.install(|| progressive.pass(&scene, integrator.as_ref(), &observer));
-            bar.set_message(format!(
-                "{} {}×{} {}/{} spp",
-                s.integrator,
-                s.width,
-                s.height,
-                progressive.samples(),
-                s.spp
-            ));
-            write(&progressive.image())?;
-        }
-    } else {
-        let progress = |n: u64| bar.inc(n);
-        let observer = RenderObserver { progress: Some(&progress), cancel: None };
-        let image = pool.install(|| render_with(&scene, integrator.as_ref(), &observer));
-        write(&image)?;
-    }
-    let elapsed = start.elapsed();
-    bar.finish_and_clear();
-    if !args.quiet {
-        let names: Vec<String> = outputs.iter().map(|p| p.display().to_string()).collect();
-        eprintln!("rendered {}×{} in {:.2} s → {}", s.width, s.height, elapsed.as_secs_f64(), names.join(", "));
-    }
-    Ok(())
 }
 
 fn gi(args: GiArgs) -> Result<(), String> {
@@ -517,21 +334,4 @@ fn attenuation(args: AttenuationArgs) -> Result<(), String> {
         .write(&args.output, 0.0, scene::Tonemap::Clamp)
         .map_err(|e| format!("cannot write `{}`: {e}", args.output.display()))?;
     Ok(())
-}
-
-fn parse_attenuation(s: &str) -> Result<airlight::light::AttenuationModel, String> {
-    use airlight::light::AttenuationModel as M;
-    Ok(match s {
-        "physical" => M::Physical,
-        "sphere" => M::Sphere,
-        "cutoff" => M::Cutoff,
-        "window_tan" => M::WindowTan,
-        "window_rational" => M::WindowRational,
-        "window_ue4" => M::WindowUe4,
-        _ => {
-            return Err(format!(
-                "unknown attenuation `{s}`; expected physical, sphere, cutoff, window_tan, window_rational or window_ue4"
-            ));
-        }
-    })
 }

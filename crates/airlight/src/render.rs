@@ -55,23 +55,36 @@ pub fn render_samples(
     count: u32,
     observer: &RenderObserver,
 ) -> Image {
+    render_moments(scene, integrator, first, count, observer).0
+}
+
+/// Like [`render_samples`], with a second image of each pixel's mean of
+/// squared samples (per channel), from which [`Progressive`] estimates the
+/// variance of its pixels.
+pub fn render_moments(
+    scene: &Scene,
+    integrator: &dyn Integrator,
+    first: u64,
+    count: u32,
+    observer: &RenderObserver,
+) -> (Image, Image) {
     let s = &scene.settings;
     let (w, h) = (s.width, s.height);
     let tiles_x = w.div_ceil(TILE);
     let tiles: Vec<(u32, u32)> = (0..h.div_ceil(TILE)).flat_map(|ty| (0..tiles_x).map(move |tx| (tx, ty))).collect();
-    let rendered: Vec<Vec<Rgb>> = tiles
+    let rendered: Vec<Vec<Moments>> = tiles
         .par_iter()
         .map(|&(tx, ty)| {
             let (x0, y0) = (tx * TILE, ty * TILE);
             let (x1, y1) = ((x0 + TILE).min(w), (y0 + TILE).min(h));
             let mut out = Vec::with_capacity(((x1 - x0) * (y1 - y0)) as usize);
             if observer.cancel.is_some_and(|c| c.load(Ordering::Relaxed)) {
-                out.resize(((x1 - x0) * (y1 - y0)) as usize, Rgb::ZERO);
+                out.resize(((x1 - x0) * (y1 - y0)) as usize, Moments::default());
                 return out;
             }
             for y in y0..y1 {
                 for x in x0..x1 {
-                    out.push(pixel_samples(scene, integrator, x, y, first, count));
+                    out.push(pixel_moments(scene, integrator, x, y, first, count));
                 }
             }
             if let Some(progress) = observer.progress {
@@ -80,16 +93,24 @@ pub fn render_samples(
             out
         })
         .collect();
-    let mut image = Image::new(w, h);
+    let (mut mean, mut mean_square) = (Image::new(w, h), Image::new(w, h));
     for (&(tx, ty), tile) in tiles.iter().zip(&rendered) {
         let (x0, y0) = (tx * TILE, ty * TILE);
         let tile_w = (x0 + TILE).min(w) - x0;
-        for (i, &p) in tile.iter().enumerate() {
+        for (i, m) in tile.iter().enumerate() {
             let (x, y) = (x0 + i as u32 % tile_w, y0 + i as u32 / tile_w);
-            image.pixels[(y * w + x) as usize] = p;
+            mean.pixels[(y * w + x) as usize] = m.mean;
+            mean_square.pixels[(y * w + x) as usize] = m.mean_square;
         }
     }
-    image
+    (mean, mean_square)
+}
+
+/// The first two moments of a pixel's samples.
+#[derive(Clone, Copy, Default)]
+struct Moments {
+    mean: Rgb,
+    mean_square: Rgb,
 }
 
 /// The mean of `spp` samples of one pixel in pass `pass`.
@@ -106,9 +127,14 @@ pub fn render_pixel(scene: &Scene, integrator: &dyn Integrator, x: u32, y: u32, 
 
 /// The mean of samples `first .. first + count` of one pixel.
 pub fn pixel_samples(scene: &Scene, integrator: &dyn Integrator, x: u32, y: u32, first: u64, count: u32) -> Rgb {
+    pixel_moments(scene, integrator, x, y, first, count).mean
+}
+
+/// The mean and mean square of samples `first .. first + count` of one pixel.
+fn pixel_moments(scene: &Scene, integrator: &dyn Integrator, x: u32, y: u32, first: u64, count: u32) -> Moments {
     let s = &scene.settings;
     let index = y as u64 * s.width as u64 + x as u64;
-    let mut sum = Rgb::ZERO;
+    let (mut sum, mut sum_square) = (Rgb::ZERO, Rgb::ZERO);
     for i in 0..count as u64 {
         let mut sampler = Sampler::for_pixel(s.seed, index, first + i);
         let (jitter, lens) = if integrator.stratified() {
@@ -127,9 +153,11 @@ pub fn pixel_samples(scene: &Scene, integrator: &dyn Integrator, x: u32, y: u32,
         // One broken sample (NaN, inf) must not spoil the pixel.
         if l.is_finite() {
             sum += l;
+            sum_square += l * l;
         }
     }
-    sum / count.max(1) as f32
+    let n = count.max(1) as f32;
+    Moments { mean: sum / n, mean_square: sum_square / n }
 }
 
 /// Progressive rendering: the scene's `spp` samples in passes of 1, 1, 2,
@@ -140,23 +168,31 @@ pub fn pixel_samples(scene: &Scene, integrator: &dyn Integrator, x: u32, y: u32,
 /// the number of passes (and rewrites of the image) grows only as log₂ spp.
 /// The result is a pure function of the scene, as for [`render`], but not
 /// bit for bit the same image: sums are grouped differently.
+///
+/// It also keeps each pixel's sum of squared samples, for the variance of
+/// its mean, s²/n with s² the unbiased sample variance: exact for
+/// independent samples, an upper bound in expectation for stratified ones
+/// (stratification only lowers the variance of the mean).
 pub struct Progressive {
     width: u32,
     height: u32,
     spp: u32,
     done: u32,
     sum: Vec<glam::DVec3>,
+    sum_square: Vec<glam::DVec3>,
 }
 
 impl Progressive {
     pub fn new(scene: &Scene) -> Self {
         let s = &scene.settings;
+        let pixels = s.width as usize * s.height as usize;
         Progressive {
             width: s.width,
             height: s.height,
             spp: s.spp,
             done: 0,
-            sum: vec![glam::DVec3::ZERO; s.width as usize * s.height as usize],
+            sum: vec![glam::DVec3::ZERO; pixels],
+            sum_square: vec![glam::DVec3::ZERO; pixels],
         }
     }
 
@@ -183,12 +219,16 @@ impl Progressive {
         if count == 0 {
             return false;
         }
-        let image = render_samples(scene, integrator, self.done as u64, count, observer);
+        let (mean, mean_square) = render_moments(scene, integrator, self.done as u64, count, observer);
         if observer.cancel.is_some_and(|c| c.load(Ordering::Relaxed)) {
             return false;
         }
-        for (acc, p) in self.sum.iter_mut().zip(&image.pixels) {
-            *acc += p.as_dvec3() * count as f64;
+        let n = count as f64;
+        for ((acc, acc_square), (p, q)) in
+            self.sum.iter_mut().zip(&mut self.sum_square).zip(mean.pixels.iter().zip(&mean_square.pixels))
+        {
+            *acc += p.as_dvec3() * n;
+            *acc_square += q.as_dvec3() * n;
         }
         self.done += count;
         true
@@ -199,5 +239,35 @@ impl Progressive {
         let n = self.done.max(1) as f64;
         let pixels = self.sum.iter().map(|s| (*s / n).as_vec3()).collect();
         Image { width: self.width, height: self.height, pixels }
+    }
+
+    /// The estimated variance of each pixel's mean, per channel: s²/n, with
+    /// s² = (Σx² − (Σx)²/n)/(n − 1). Infinite before two samples.
+    pub fn variance(&self) -> Image {
+        let pixels = self.sum.iter().zip(&self.sum_square).map(|(s, q)| self.variance_of_mean(*s, *q).as_vec3());
+        Image { width: self.width, height: self.height, pixels: pixels.collect() }
+    }
+
+    fn variance_of_mean(&self, sum: glam::DVec3, sum_square: glam::DVec3) -> glam::DVec3 {
+        if self.done < 2 {
+            return glam::DVec3::INFINITY;
+        }
+        let n = self.done as f64;
+        let sample_variance = ((sum_square - sum * sum / n) / (n - 1.0)).max(glam::DVec3::ZERO);
+        sample_variance / n
+    }
+
+    /// The estimated relative error of the image: √(Σ Var(mean) / Σ mean²)
+    /// over pixels and channels, what [`crate::film::compare`]'s `rel_rmse`
+    /// against the converged image is expected to be. Infinite before two
+    /// samples or for a black image.
+    pub fn estimated_relative_error(&self) -> f64 {
+        let n = self.done.max(1) as f64;
+        let (mut variance, mut signal) = (0.0, 0.0);
+        for (s, q) in self.sum.iter().zip(&self.sum_square) {
+            variance += self.variance_of_mean(*s, *q).element_sum();
+            signal += (*s / n).length_squared();
+        }
+        if signal > 0.0 { (variance / signal).sqrt() } else { f64::INFINITY }
     }
 }

@@ -290,6 +290,25 @@ fn scenes_the_analytic_integrator_cannot_render_say_why() {
     // A sun without a medium lights surfaces only: fine.
     let scene = airlight::scene::from_toml_str(&base("", sun), None).unwrap();
     assert!(integrator::for_scene(&scene).is_ok());
+    // A volume light.
+    let volume = "[[lights]]\ntype = \"box\"\nmin = [-0.4, 2.6, -0.4]\nmax = [0.4, 3.4, 0.4]\nintensity = 30.0";
+    let scene = airlight::scene::from_toml_str(&base(fog, volume), None).unwrap();
+    let err = integrator::for_scene(&scene).err().unwrap();
+    assert!(err.contains("volume light"), "{err}");
+    // A real-time attenuation window: the closed form is for 1/r² only.
+    let windowed = format!("{point}\nattenuation = \"window_ue4\"\nrange = 5.0");
+    let scene = airlight::scene::from_toml_str(&base(fog, &windowed), None).unwrap();
+    let err = integrator::for_scene(&scene).err().unwrap();
+    assert!(err.contains("attenuation"), "{err}");
+    // SDF objects with shadows (without shadows they only end rays: fine).
+    let sdf = "[[objects]]\ntype = \"sdf\"\nmaterial = \"m\"\nshape = \"box\"\nmin = [2, 0, 2]\nmax = [3, 1, 3]";
+    let with_sdf = |shadows: bool| {
+        let text = base(fog, point).replacen("[render]\n", &format!("[render]\nshadows = {shadows}\n"), 1);
+        airlight::scene::from_toml_str(&format!("{text}\n{sdf}"), None).unwrap()
+    };
+    let err = integrator::for_scene(&with_sdf(true)).err().unwrap();
+    assert!(err.contains("SDF"), "{err}");
+    assert!(integrator::for_scene(&with_sdf(false)).is_ok());
 }
 
 #[test]

@@ -132,10 +132,43 @@ fn quad_light_on_a_floor_through_the_integrators_matches_lambert() {
     let expected = lambert_irradiance(corner, u, v, 1.0) / std::f64::consts::PI;
     for (name, integrator) in [
         ("direct", &Direct as &dyn Integrator),
-        ("path", &airlight::integrator::PathTracer { max_depth: 1 }),
+        ("path", &airlight::integrator::PathTracer::new(1)),
         ("raymarch", &airlight::integrator::Raymarch { steps: 4, jitter: true }),
     ] {
         let got = render_with(&scene, integrator, &RenderObserver::none()).mean().x as f64;
         assert!((got / expected - 1.0).abs() < 0.01, "{name}: {got} vs {expected}");
     }
+}
+
+#[test]
+fn surfaces_see_an_area_light_at_a_slant_but_not_through_a_blocker() {
+    // Floor points lifted off the floor see points of a ceiling quad light
+    // (which is geometry too) from every angle up to grazing; a shadow ray
+    // that kept the direction from the unlifted point would meet the
+    // light's surface before its end at slants beyond about 50°.
+    let scene = SceneBuilder::new()
+        .material("m", Material::diffuse(Rgb::splat(0.5)))
+        .object(Shape::plane(Vec3::ZERO, Vec3::Y), "m")
+        .light(Light::quad(vec3(-0.5, 2.0, -0.5), vec3(1.0, 0.0, 0.0), vec3(0.0, 0.0, 1.0), Rgb::ONE))
+        .build()
+        .unwrap();
+    let y = vec3(0.2, 2.0, 0.1);
+    for x in [0.0f32, 1.0, 2.0, 3.0, 5.0, 10.0, 30.0] {
+        let p = vec3(x, 0.0, 0.3 * x);
+        let (wi, distance) = ((y - p).normalize(), (y - p).length());
+        let origin = airlight::geometry::offset_origin(p, Vec3::Y, wi);
+        assert!(scene.light_visible(p, origin, wi, distance), "floor point {p} sees the light at {y}");
+    }
+    // A box between them blocks it.
+    let blocked = SceneBuilder::new()
+        .material("m", Material::diffuse(Rgb::splat(0.5)))
+        .object(Shape::plane(Vec3::ZERO, Vec3::Y), "m")
+        .object(Shape::cuboid(vec3(1.0, 0.5, 0.0), vec3(2.0, 1.5, 1.0)), "m")
+        .light(Light::quad(vec3(-0.5, 2.0, -0.5), vec3(1.0, 0.0, 0.0), vec3(0.0, 0.0, 1.0), Rgb::ONE))
+        .build()
+        .unwrap();
+    let p = vec3(3.0, 0.0, 0.5);
+    let (wi, distance) = ((y - p).normalize(), (y - p).length());
+    let origin = airlight::geometry::offset_origin(p, Vec3::Y, wi);
+    assert!(!blocked.light_visible(p, origin, wi, distance));
 }

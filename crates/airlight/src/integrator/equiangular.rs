@@ -11,6 +11,10 @@
 //!
 //! Its integral over [t0, t1] is (atan((t1 − t_c)/h) − atan((t0 − t_c)/h))/(θb − θa)
 //! = 1: the Monte Carlo twin of the closed-form atan of the airlight integral.
+//!
+//! For an extended light the integrand is bounded where the ray passes
+//! through or near it, so h may be raised to a `spread` (any h > 0 gives a
+//! normalised pdf, a truncated Cauchy distribution): the light's size.
 
 use glam::Vec3;
 
@@ -29,13 +33,14 @@ pub struct Equiangular {
 }
 
 impl Equiangular {
-    /// The distribution for the ray o + t·d (d unit), t in [t0, t1], about `y`.
-    pub fn new(o: Vec3, d: Vec3, y: Vec3, t0: f32, t1: f32) -> Self {
+    /// The distribution for the ray o + t·d (d unit), t in [t0, t1], about
+    /// `y`, with h no less than `spread`.
+    pub fn new(o: Vec3, d: Vec3, y: Vec3, spread: f32, t0: f32, t1: f32) -> Self {
         let (o, d, y) = (o.as_dvec3(), d.as_dvec3(), y.as_dvec3());
         let tc = (y - o).dot(d);
         let (t0, t1) = (t0 as f64, t1 as f64);
         let floor = 1e-6 * (1.0 + (t1 - t0).abs() + tc.abs());
-        let h = (o + d * tc - y).length().max(floor);
+        let h = (o + d * tc - y).length().max(floor).max(spread as f64);
         let theta_a = ((t0 - tc) / h).atan();
         let theta_b = ((t1 - tc) / h).atan();
         Equiangular { t0, t1, tc, h, theta_a, theta_b }
@@ -67,12 +72,14 @@ mod tests {
         let o = Vec3::new(0.2, -0.1, 0.3);
         let d = Vec3::new(0.3, 0.2, 1.0).normalize();
         vec![
-            Equiangular::new(o, d, Vec3::new(1.0, 1.0, 4.0), 0.0, 10.0),
-            // The point beside the start, behind it, close to the line, far away.
-            Equiangular::new(o, d, o + Vec3::new(0.5, 0.0, 0.0), 0.0, 5.0),
-            Equiangular::new(o, d, o - d * 3.0 + Vec3::Y, 0.0, 5.0),
-            Equiangular::new(o, d, o + d * 2.0 + Vec3::X * 0.01, 0.5, 4.0),
-            Equiangular::new(o, d, Vec3::new(50.0, 20.0, -30.0), 0.0, 3.0),
+            Equiangular::new(o, d, Vec3::new(1.0, 1.0, 4.0), 0.0, 0.0, 10.0),
+            // The point beside the start, behind it, close to the line, far
+            // away; a spread wider than the distance to the line.
+            Equiangular::new(o, d, o + Vec3::new(0.5, 0.0, 0.0), 0.0, 0.0, 5.0),
+            Equiangular::new(o, d, o - d * 3.0 + Vec3::Y, 0.0, 0.0, 5.0),
+            Equiangular::new(o, d, o + d * 2.0 + Vec3::X * 0.01, 0.0, 0.5, 4.0),
+            Equiangular::new(o, d, Vec3::new(50.0, 20.0, -30.0), 0.0, 0.0, 3.0),
+            Equiangular::new(o, d, o + d * 2.0 + Vec3::X * 0.01, 0.7, 0.5, 4.0),
         ]
     }
 

@@ -100,7 +100,7 @@ pub fn for_scene(scene: &Scene) -> Result<Box<dyn Integrator>, String> {
     match s.integrator {
         IntegratorKind::Direct => Ok(Box::new(Direct)),
         IntegratorKind::Raymarch => Ok(Box::new(Raymarch { steps: s.steps, jitter: s.jitter })),
-        IntegratorKind::Path => Ok(Box::new(PathTracer { max_depth: s.max_depth })),
+        IntegratorKind::Path => Ok(Box::new(PathTracer::new(s.max_depth))),
         IntegratorKind::Radiosity => Ok(Box::new(RadiosityIntegrator::new(scene).map_err(|e| e.to_string())?)),
         IntegratorKind::Analytic => Ok(Box::new(Analytic::new(scene, analytic::AnalyticOptions::from_settings(s))?)),
         IntegratorKind::Stochastic => Ok(Box::new(Stochastic { sampling: s.sampling, stratify: s.stratify })),
@@ -110,7 +110,7 @@ pub fn for_scene(scene: &Scene) -> Result<Box<dyn Integrator>, String> {
 /// Radiance leaving a surface toward `-ray.dir`: its emission plus direct
 /// light from every light, one sample per area light, with shadow rays. In a
 /// medium, light arriving from each light is attenuated on its way.
-pub(crate) fn surface_radiance(
+pub fn surface_radiance(
     scene: &Scene,
     ray: &Ray,
     surface: &SurfaceHit,
@@ -136,8 +136,7 @@ pub(crate) fn surface_radiance(
         }
         let origin = offset_origin(surface.p, surface.n, sample.wi);
         let distance = scene.light_distance(sample.distance);
-        if scene.geometry.occluded(origin, sample.wi, scene.shadow_span(surface.p, origin, sample.wi, sample.distance))
-        {
+        if !scene.light_visible(surface.p, origin, sample.wi, sample.distance) {
             return;
         }
         let mut contribution = f * sample.weight * cos;

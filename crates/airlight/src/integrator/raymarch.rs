@@ -88,7 +88,7 @@ pub fn in_scattered(
         scene.for_each_light_at(p, |index, light| {
             let Some(sample) = light.sample(p, keyed2(key, index as u64)) else { return };
             let distance = scene.light_distance(sample.distance);
-            if scene.geometry.occluded(p, sample.wi, scene.shadow_span(p, p, sample.wi, sample.distance)) {
+            if !scene.light_visible(p, p, sample.wi, sample.distance) {
                 return;
             }
             let phase = medium.phase(wo, sample.wi);

@@ -16,8 +16,8 @@
 //!   light the seed's sum d/(1 + dist)² is this estimator with its fudge
 //!   factors (the "+1", the unknown scale) replaced by the physical ones.
 //! - `equiangular`: pdf(t) ∝ 1/r² toward the light's anchor point (the point
-//!   light itself, or the sampled point y of a volume light), Kulla and
-//!   Fajardo 2012 (equiangular.rs).
+//!   light itself, or the centre of an extended light with its size as the
+//!   least distance, `Light::anchor`), Kulla and Fajardo 2012 (equiangular.rs).
 //! - `mis`: one-sample multiple importance sampling of the two with the
 //!   balance heuristic (Veach 1997, section 9.2.4): the strategy is chosen with
 //!   probability 1/2 and the sample weighted by 1/(½pdf_uniform + ½pdf_equiangular).
@@ -120,14 +120,14 @@ impl Integrator for Stochastic {
                 [sampler.next(), sampler.next(), sampler.next(), sampler.next()]
             };
             let u_light = Vec3::new(u[1], u[2], u[3]);
-            let Some((t, pdf)) = self.distance(ray, length, light.anchor(u_light), u[0]) else { continue };
+            let Some((t, pdf)) = self.distance(ray, length, light.anchor(), u[0]) else { continue };
             let x = ray.at(t);
             let Some(sample) = light.sample3(x, u_light) else { continue };
             if sample.weight == Rgb::ZERO {
                 continue;
             }
             let distance = scene.light_distance(sample.distance);
-            if scene.geometry.occluded(x, sample.wi, distance * (1.0 - 1e-4)) {
+            if !scene.light_visible(x, x, sample.wi, sample.distance) {
                 continue;
             }
             let to_eye = medium.transmittance(ray.origin, ray.dir, 0.0, t);
@@ -143,11 +143,11 @@ impl Integrator for Stochastic {
 impl Stochastic {
     /// A distance t in [0, length] along the ray and its pdf, by the chosen
     /// strategy, given the light's anchor point (uniform without one).
-    fn distance(&self, ray: &Ray, length: f32, anchor: Option<Vec3>, u: f32) -> Option<(f32, f32)> {
+    fn distance(&self, ray: &Ray, length: f32, anchor: Option<(Vec3, f32)>, u: f32) -> Option<(f32, f32)> {
         let uniform_pdf = 1.0 / length;
         let equiangular = match (self.sampling, anchor) {
             (Sampling::Uniform, _) | (_, None) => return Some((u * length, uniform_pdf)),
-            (_, Some(y)) => Equiangular::new(ray.origin, ray.dir, y, 0.0, length),
+            (_, Some((y, spread))) => Equiangular::new(ray.origin, ray.dir, y, spread, 0.0, length),
         };
         let (t, pdf) = match self.sampling {
             Sampling::Equiangular => {

@@ -183,37 +183,46 @@ impl Light {
         Light::Volume { shape: LightVolume::Sphere { center, radius }, intensity }
     }
 
-    /// A point that stands for the light when choosing where to look from:
-    /// equiangular sampling of a ray draws points in proportion to 1/r² from
-    /// it. The light's own point for point and spot lights; a point drawn
-    /// uniformly in the region from `u` for volume lights (the same point
-    /// [`sample3`](Self::sample3) uses with this `u`, so the two form one
-    /// joint sample); the centre of sphere and quad lights; none for a sun.
-    pub fn anchor(&self, u: Vec3) -> Option<Vec3> {
+    /// A point that stands for the light when choosing where along a ray to
+    /// look from, and a spread: equiangular sampling draws t in proportion to
+    /// 1/(max(h, spread)² + (t − t_c)²) about it. The light's own point
+    /// (spread 0) for point and spot lights; the centre of sphere lights
+    /// (spread 0: outside, a sphere's light falls as from its centre); for
+    /// volume and quad lights the centre and R/√3, R the radius of the ball
+    /// (disk) of equal volume (area), or half a line light's length, so
+    /// that the Cauchy profile I/(R²/3 + s²)
+    /// matches a uniform ball's light, 3I/R² at its centre and I/s² far
+    /// away; none for a sun.
+    pub fn anchor(&self) -> Option<(Vec3, f32)> {
+        let spread = |r: f32| r / 3f32.sqrt();
         match *self {
-            Light::Point { position, .. } | Light::Spot { position, .. } => Some(position),
-            Light::Volume { shape, .. } => Some(shape.sample_point(u)),
-            Light::Sphere { center, .. } => Some(center),
-            Light::Quad { corner, edge_u, edge_v, .. } => Some(corner + 0.5 * (edge_u + edge_v)),
-            Light::Line { start, end, .. } => Some(0.5 * (start + end)),
+            Light::Point { position, .. } | Light::Spot { position, .. } => Some((position, 0.0)),
+            Light::Volume { shape, .. } => Some((shape.center(), spread(shape.equivalent_radius()))),
+            Light::Sphere { center, .. } => Some((center, 0.0)),
+            Light::Quad { corner, edge_u, edge_v, .. } => {
+                let radius = (edge_u.cross(edge_v).length() / std::f32::consts::PI).sqrt();
+                Some((corner + 0.5 * (edge_u + edge_v), spread(radius)))
+            }
+            Light::Line { start, end, .. } => Some((0.5 * (start + end), spread(0.5 * (end - start).length()))),
             Light::Distant { .. } => None,
         }
     }
 
     /// Like [`sample`](Self::sample) with three uniform numbers: volume
-    /// lights use all three (a point y uniform in the region, pdf 1/V:
-    /// weight = (I/V)/|y − p|² / (1/V) = I/|y − p|²); other lights use the
-    /// first two.
+    /// lights use all three (a direction in the cone holding the region and
+    /// a distance on the chord, volume.rs: weight ε·Ω_c·(r₁ − r₀) with
+    /// ε = I/V); other lights use the first two.
     pub fn sample3(&self, p: Vec3, u: Vec3) -> Option<LightSample> {
         match *self {
             Light::Volume { shape, intensity } => {
-                let to = shape.sample_point(u) - p;
-                let d2 = to.length_squared();
-                if d2 <= 0.0 || !d2.is_finite() {
+                let (y, per_emission) = shape.sample_from(p, u)?;
+                let to = y - p;
+                let distance = to.length();
+                if !(distance > 0.0 && distance.is_finite()) {
                     return None;
                 }
-                let distance = d2.sqrt();
-                Some(LightSample { wi: to / distance, distance, weight: intensity / d2, pdf: 0.0 })
+                let weight = intensity * (per_emission / shape.volume());
+                Some(LightSample { wi: to / distance, distance, weight, pdf: 0.0 })
             }
             _ => self.sample(p, u.xy()),
         }

@@ -9,8 +9,21 @@
 //!
 //! It is a region, not a surface: it casts no shadow, reflects nothing, and
 //! the camera sees it only by the light its surroundings scatter.
+//!
+//! Sampling from a point x: with y = x + r·ω, dy = r² dr dω, so
+//! ∫_V ε·g(y)/|x − y|² dy = ∫_Ω ∫_chord(ω) ε·g dr dω: the 1/r² cancels. A
+//! direction is drawn uniformly in a cone Ω_c that holds the region (the cone
+//! of its bounding sphere from x; every direction from inside it) and a
+//! distance uniformly on the chord [r₀, r₁] the region cuts from that
+//! direction, so pdf(y) = 1/(Ω_c·(r₁ − r₀)·r²) and the weight is
+//! ε·Ω_c·(r₁ − r₀): bounded, even for x inside the light, where a uniform
+//! point in the volume would give the unbounded I/r².
+//! Outside the bounding sphere, a uniform point in the region is used
+//! instead (pdf 1/V, weight ε·V/r², bounded there).
 
+use crate::sampling::{basis, uniform_cone, uniform_sphere};
 use glam::{Vec2, Vec3};
+use std::f32::consts::PI;
 
 /// The region a volume light fills.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -55,7 +68,79 @@ impl LightVolume {
         let (lo, hi) = self.bounds();
         0.5 * (lo + hi)
     }
+
+    /// The radius of the ball of the same volume, (3V/4π)^⅓.
+    pub fn equivalent_radius(&self) -> f32 {
+        (3.0 * self.volume() / (4.0 * PI)).cbrt()
+    }
+
+    /// The chord [r₀, r₁] (r₀ ≥ 0) the region cuts from the ray x + r·ω, if any.
+    fn chord(&self, x: Vec3, w: Vec3) -> Option<(f32, f32)> {
+        let (near, far) = match *self {
+            LightVolume::Box { min, max } => {
+                let inv = w.recip();
+                let (a, b) = ((min - x) * inv, (max - x) * inv);
+                (a.min(b).max_element(), a.max(b).min_element())
+            }
+            LightVolume::Sphere { center, radius } => {
+                let oc = center - x;
+                let along = oc.dot(w);
+                let h2 = (oc - w * along).length_squared();
+                let half = (radius * radius - h2).max(0.0).sqrt();
+                if h2 > radius * radius {
+                    return None;
+                }
+                (along - half, along + half)
+            }
+        };
+        let near = near.max(0.0);
+        (far > near).then_some((near, far))
+    }
+
+    /// A point y of the region seen from x, drawn as the module notes say
+    /// from u uniform in [0, 1)³, with Ω_c·(r₁ − r₀) (the weight per unit ε),
+    /// or None when the direction drawn misses the region (a box in its
+    /// bounding cone).
+    pub fn sample_from(&self, x: Vec3, u: Vec3) -> Option<(Vec3, f32)> {
+        let (center, bound) = match *self {
+            LightVolume::Sphere { center, radius } => (center, radius),
+            LightVolume::Box { min, max } => (0.5 * (min + max), 0.5 * (max - min).length()),
+        };
+        let to_center = center - x;
+        let d2 = to_center.length_squared();
+        if d2 > FAR * FAR * bound * bound {
+            // Far away, 1/r² varies little over the region: a uniform point
+            // (pdf 1/V, weight per unit ε V/r²) wastes no samples on the
+            // parts of the bounding cone that miss a box.
+            let y = self.sample_point(u);
+            let r2 = (y - x).length_squared();
+            return (r2 > 0.0).then(|| (y, self.volume() / r2));
+        }
+        let (w, solid_angle) = if d2 <= bound * bound {
+            (uniform_sphere(Vec2::new(u.x, u.y)), 4.0 * PI)
+        } else {
+            // 1 − cos θmax as sin²/(1 + cos), accurate for small cones.
+            let sin2 = bound * bound / d2;
+            let cos_max = (1.0 - sin2).max(0.0).sqrt();
+            let one_minus_cos = sin2 / (1.0 + cos_max);
+            let local = uniform_cone(Vec2::new(u.x, u.y), cos_max);
+            let axis = to_center / d2.sqrt();
+            let (t, b) = basis(axis);
+            ((t * local.x + b * local.y + axis * local.z).normalize(), 2.0 * PI * one_minus_cos)
+        };
+        let (r0, r1) = self.chord(x, w)?;
+        let r = r0 + u.z * (r1 - r0);
+        Some((x + w * r, solid_angle * (r1 - r0)))
+    }
 }
+
+/// Beyond this many bounding radii from its centre a region is sampled by a
+/// uniform point in it rather than along chords (module notes). Outside the
+/// bounding sphere the chord sampler's misses of a box cost more than its
+/// bounded weight gains: on the stochastic-against-raymarch test with a box
+/// light, 1 gave a relative RMSE of 0.0089 (uniform distances) where 2 gave
+/// 0.0101 and chords everywhere 0.0119, at the same sample counts.
+const FAR: f32 = 1.0;
 
 /// A third uniform number made from two, for the callers of
 /// [`Light::sample`](super::Light::sample) that draw two: a hash (SplitMix64's
@@ -141,10 +226,10 @@ mod tests {
         // Gauss again, for a box: the irradiance over any closed surface
         // around the light integrates to its power, 4π·I. The surface: a
         // sphere of radius 3 about a point off the box's centre, on a
-        // 48 × 96 grid in (cos θ, φ).
+        // 24 × 48 grid in (cos θ, φ), each point from a 24³ grid of light samples.
         let light = Light::volume_box(Vec3::new(-0.5, 0.2, -0.3), Vec3::new(0.7, 0.6, 0.9), Rgb::splat(5.0));
         let c = DVec3::new(0.3, -0.2, 0.1);
-        let (nt, np) = (48, 96);
+        let (nt, np) = (24, 48);
         let mut flux = 0.0;
         for i in 0..nt {
             for j in 0..np {
@@ -152,7 +237,7 @@ mod tests {
                 let phi = 2.0 * PI * (j as f64 + 0.5) / np as f64;
                 let r = (1.0 - z * z).sqrt();
                 let n = DVec3::new(r * phi.cos(), r * phi.sin(), z);
-                let e = integrate(&light, (c + n * 3.0).as_vec3(), -n.as_vec3(), 12);
+                let e = integrate(&light, (c + n * 3.0).as_vec3(), -n.as_vec3(), 24);
                 // dA = R² dz dφ; light arrives inward, against n.
                 flux += e * 9.0 * (2.0 / nt as f64) * (2.0 * PI / np as f64);
             }
@@ -162,23 +247,58 @@ mod tests {
     }
 
     #[test]
-    fn two_number_sampling_is_uniform_over_the_volume() {
-        // `sample` with two numbers hashes a third: the points it picks must
-        // fill the box uniformly (each octant an eighth, mean at the centre).
-        let light = Light::volume_box(Vec3::ZERO, Vec3::new(2.0, 1.0, 4.0), Rgb::ONE);
-        let mut s = crate::sampling::Sampler::for_pixel(4, 4, 4);
-        let mut octants = [0u32; 8];
-        let n = 80_000;
-        for _ in 0..n {
-            let p = Vec3::new(-1.0, -1.0, -1.0);
-            let sample = light.sample(p, s.next2()).unwrap();
-            let y = p + sample.wi * sample.distance;
-            let o = (y.x > 1.0) as usize | ((y.y > 0.5) as usize) << 1 | ((y.z > 2.0) as usize) << 2;
-            octants[o] += 1;
-            assert!((sample.weight.x - 1.0 / (sample.distance * sample.distance)).abs() < 1e-3 * sample.weight.x);
+    fn two_number_sampling_estimates_the_fluence() {
+        // `sample` with two numbers hashes a third: its Monte Carlo mean must
+        // be the fluence ∫ ε/r² dy. From outside, the independent answer is
+        // a 64³ midpoint rule over the box; from inside, where 1/r² is
+        // singular, ∫ dy/r² = ∫ r_exit(ω) dω over all directions (dy = r² dr dω),
+        // with the exit distance by slabs, on a 512 × 1024 grid in (cos θ, φ).
+        let (lo, hi) = (Vec3::ZERO, Vec3::new(2.0, 1.0, 4.0));
+        let light = Light::volume_box(lo, hi, Rgb::ONE);
+        let epsilon = 1.0 / 8.0;
+        // Near (chords through the bounding cone) and far (a uniform point).
+        let (near, far) = (Vec3::new(-1.0, -1.0, -1.0), Vec3::new(-6.0, -5.0, -4.0));
+        let midpoint = |outside: Vec3| {
+            let k = 64;
+            let mut sum = 0.0f64;
+            for i in 0..k {
+                for j in 0..k {
+                    for l in 0..k {
+                        let y = lo + (hi - lo) * ((Vec3::new(i as f32, j as f32, l as f32) + 0.5) / k as f32);
+                        sum += 1.0 / (y - outside).length_squared() as f64;
+                    }
+                }
+            }
+            epsilon * sum * 8.0 / (k * k * k) as f64
+        };
+        let inside = DVec3::new(0.5, 0.4, 1.0);
+        let (lo_d, hi_d) = (lo.as_dvec3(), hi.as_dvec3());
+        let (nt, np) = (512, 1024);
+        let mut directions = 0.0f64;
+        for i in 0..nt {
+            for j in 0..np {
+                let z = -1.0 + 2.0 * (i as f64 + 0.5) / nt as f64;
+                let phi = 2.0 * PI * (j as f64 + 0.5) / np as f64;
+                let r = (1.0 - z * z).sqrt();
+                let w = DVec3::new(r * phi.cos(), r * phi.sin(), z);
+                let exit = ((lo_d - inside) / w).max((hi_d - inside) / w).min_element();
+                directions += exit;
+            }
         }
-        for c in octants {
-            assert!((c as f64 / n as f64 - 0.125).abs() < 0.005, "{octants:?}");
+        let inside_exact = epsilon * directions * 4.0 * PI / (nt * np) as f64;
+        for (p, exact) in [(near, midpoint(near)), (far, midpoint(far)), (inside.as_vec3(), inside_exact)] {
+            let mut s = crate::sampling::Sampler::for_pixel(4, 4, 4);
+            let n = 400_000;
+            let mut sum = 0.0f64;
+            for _ in 0..n {
+                if let Some(sample) = light.sample(p, s.next2()) {
+                    sum += sample.weight.x as f64;
+                    let y = p + sample.wi * sample.distance;
+                    assert!(y.cmpge(lo - 1e-4).all() && y.cmple(hi + 1e-4).all());
+                }
+            }
+            let est = sum / n as f64;
+            assert!((est / exact - 1.0).abs() < 0.005, "{p}: {est} vs {exact}");
         }
     }
 }

@@ -59,12 +59,7 @@ fn patch_irradiance(scene: &Scene, p: &Patch, lights: &[Light], key: u64) -> Rgb
                 continue;
             }
             let origin = offset_origin(p.center, p.normal, sample.wi);
-            // Shorter than Scene::shadow_span by the lift's full length:
-            // with shadow_span the Cornell box's one-bounce test reads 5.5%
-            // low against its Monte Carlo reference, with this 2.5% (not yet
-            // understood; see the closing note of issue 7).
-            let reach = scene.light_distance(sample.distance) * (1.0 - 1e-4) - (origin - p.center).length();
-            if scene.geometry.occluded(origin, sample.wi, reach) {
+            if !scene.light_visible(p.center, origin, sample.wi, sample.distance) {
                 continue;
             }
             sum += sample.weight * cos;

@@ -53,16 +53,22 @@ const fn directions(s: usize, a: u32, m: &[u32]) -> [u32; 32] {
 /// Coordinate `dim` (0..4) of Sobol' point `index`, as 32 fixed-point bits.
 #[inline]
 pub fn sobol(index: u32, dim: usize) -> u32 {
-    let v = &DIRECTIONS[dim];
-    let mut x = 0;
-    let mut bits = index;
-    let mut k = 0;
-    while bits != 0 {
-        if bits & 1 == 1 {
-            x ^= v[k];
-        }
-        bits >>= 1;
-        k += 1;
+    sobol4(index)[dim]
+}
+
+/// All four coordinates of Sobol' point `index`. Branch-free (a mask per
+/// bit), since shuffled indices have random bits that defeat prediction;
+/// dimension 0 is the bit reversal of the index.
+#[inline]
+fn sobol4(index: u32) -> [u32; 4] {
+    let mut x = [index.reverse_bits(), 0, 0, 0];
+    let bits = 32 - index.leading_zeros() as usize;
+    let columns = DIRECTIONS[1].iter().zip(&DIRECTIONS[2]).zip(&DIRECTIONS[3]).take(bits);
+    for (k, ((v1, v2), v3)) in columns.enumerate() {
+        let mask = 0u32.wrapping_sub((index >> k) & 1);
+        x[1] ^= v1 & mask;
+        x[2] ^= v2 & mask;
+        x[3] ^= v3 & mask;
     }
     x
 }
@@ -98,10 +104,10 @@ fn dimension_seed(seed: u32, i: u32) -> u32 {
 /// Point `index` of the shuffled, Owen-scrambled 4D Sobol' sequence with
 /// this seed, each coordinate in [0, 1).
 pub fn scrambled_sobol4(index: u32, seed: u32) -> [f32; 4] {
-    let shuffled = owen_scramble(index, seed);
+    let point = sobol4(owen_scramble(index, seed));
     let mut out = [0.0; 4];
     for (d, slot) in out.iter_mut().enumerate() {
-        let x = owen_scramble(sobol(shuffled, d), dimension_seed(seed, d as u32));
+        let x = owen_scramble(point[d], dimension_seed(seed, d as u32));
         // The top 24 bits: exact in an f32, strictly below 1.
         *slot = (x >> 8) as f32 * (1.0 / (1u32 << 24) as f32);
     }

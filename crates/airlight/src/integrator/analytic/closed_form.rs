@@ -18,6 +18,7 @@
 
 use super::expint::{Complex, scaled_e1};
 use super::quadrature::gl8;
+use super::table::im_s;
 use glam::{DVec3, Vec3};
 
 /// The relative floor on p: a light on or near the ray's line is treated as
@@ -130,6 +131,16 @@ impl Glow {
         let z = Complex::new(self.sigma_t * w, -self.sigma_t * self.p);
         let s = scaled_e1(z);
         2.0 / self.p * (-self.sigma_t * (self.h + w)).exp() * s.im
+    }
+
+    /// K(t) with Im S read from the table ([`super::table::im_s`], relative
+    /// error at most [`super::TABLE_ERROR`]): what the renderer uses.
+    #[inline]
+    pub fn antiderivative_tabulated(&self, t: f64) -> f64 {
+        let y = t - self.h;
+        let w = y_plus_r(self.p, y);
+        let s = im_s(self.sigma_t * w, self.sigma_t * self.p);
+        2.0 / self.p * (-self.sigma_t * (self.h + w)).exp() * s
     }
 
     /// G(t₀, t₁) given K(t₀) and K(t₁) (any values when σt = 0).

@@ -16,7 +16,11 @@
 //! - when phase·m is constant (isotropic phase, inside a spot's inner cone,
 //!   lit), the integral is exact: [`glow_vacuum`] (the seed's atan form) for
 //!   σt = 0, [`Glow`] (Sun et al.'s F through the complex exponential
-//!   integral) for σt > 0;
+//!   integral) for σt > 0. The renderer reads Im S = Im e^z E₁(z), the one
+//!   special function in it, from a table (as Sun et al. tabulate F; see
+//!   table.rs: relative error ≤ [`TABLE_ERROR`] = 2e-7), once per piece
+//!   boundary for all three channels when σt is grey; the public closed
+//!   forms ([`Glow::between`], [`glow_extinction`], [`sun_f`]) stay exact;
 //! - otherwise (Henyey–Greenstein with g ≠ 0, a spot's soft edge, a quad
 //!   light's cosine) the exact integral of the attenuation alone is
 //!   multiplied by the mean of phase·m weighted by that attenuation, taken by
@@ -34,12 +38,28 @@
 //! point spacings (each point then shows its own glow), so per ray a piece
 //! of the light that the ray passes close to is halved (line, up to 8
 //! times) or quartered (quad, up to 3 times) and the rule applied on each
-//! part: an adaptive composite rule, which leaves far rays with n points. A sphere light of radiance L and
+//! part: an adaptive composite rule, which leaves far rays with n points.
+//! A sphere light of radiance L and
 //! radius R is, for points outside it, exactly a point light of intensity
 //! πR²L at its centre (a Lambertian sphere's radiant intensity; exact for
 //! isotropic scattering when the extinction along the different paths from
 //! its surface is neglected, O(σt R)).
+//!
+//! Shadows (`shadows = true`): without meshes, each occluder's shadow along
+//! the ray is one interval, found exactly from its boundaries and cheap
+//! segment–shape tests, with no shadow rays (blockers.rs, shadows.rs);
+//! occluders whose bounding sphere cannot touch the triangle swept by the
+//! ray's shadow segments are skipped. With meshes, boundaries are bracketed
+//! by a coarse march and bisection and each piece takes one shadow ray.
+//!
+//! What it refuses, with a message naming the light or object and the
+//! integrator to use instead ([`Analytic::new`]): height fog (the closed form
+//! needs a homogeneous medium), volume lights, distant lights in a medium,
+//! lights with a real-time attenuation model other than `physical` (the
+//! closed form integrates 1/r²), and SDF objects when `shadows` is on (they
+//! have no exact shadow boundaries; without shadows they only end rays).
 
+mod blockers;
 mod boundaries;
 mod closed_form;
 mod expint;
@@ -47,6 +67,7 @@ mod lights;
 mod modulation;
 mod quadrature;
 mod shadows;
+mod table;
 
 pub use boundaries::{
     box_boundaries, box_edges, cone_crossings, edge_boundaries, plane_boundaries, polygon_boundaries, quadratic_roots,
@@ -56,15 +77,17 @@ pub use closed_form::{Glow, P_FLOOR, glow_extinction, glow_vacuum, glow_vacuum_f
 pub use expint::{Complex, scaled_e1};
 pub use lights::sphere_factor;
 pub use quadrature::Rule;
+pub use table::{TABLE_ERROR, im_s as im_s_tabulated, sun_f_tabulated};
 
+use blockers::Blocker;
 use lights::Extended;
 use modulation::MediumConsts;
-use shadows::visible;
+use shadows::{in_intervals, visible};
 
 use super::{Integrator, surface_radiance};
 use crate::Rgb;
-use crate::geometry::{Occluder, Ray};
-use crate::light::{Light, SpotProfile};
+use crate::geometry::Ray;
+use crate::light::{AttenuationModel, Light, SpotProfile};
 use crate::medium::{Density, Medium};
 use crate::sampling::Sampler;
 use crate::scene::{RenderSettings, Scene};
@@ -142,6 +165,8 @@ pub struct Analytic {
     extended: Vec<Extended>,
     /// The rule over each piece of a line or quad light, on [0, 1].
     rule: Rule,
+    /// The occluders other than triangles, in f64 (for shadows).
+    blockers: Vec<Blocker>,
     /// Whether some occluder is a triangle: shadow boundaries on meshes are
     /// bracketed by a coarse march and refined by bisection.
     meshes: bool,
@@ -153,8 +178,10 @@ pub const MESH_MARCH_STEPS: usize = 64;
 const MODULATED_POINTS: usize = 16;
 
 impl Analytic {
-    /// The integrator for `scene`, or why it cannot render it: the medium
-    /// must be homogeneous, and distant lights have no closed form here.
+    /// The integrator for `scene`, or why it cannot render it (a message for
+    /// the user, never a panic): height fog, volume lights, distant lights
+    /// in a medium, non-physical attenuation models, and SDF objects with
+    /// shadows are refused (see the module documentation).
     pub fn new(scene: &Scene, options: AnalyticOptions) -> Result<Analytic, String> {
         let in_medium = scene.medium.as_ref().is_some_and(|m| m.sigma_s != Rgb::ZERO);
         if options.shadows && scene.geometry.has_sdf() {
@@ -181,6 +208,22 @@ impl Analytic {
         let mut extended = Vec::new();
         for (i, light) in scene.lights.iter().enumerate() {
             let index = i as u32;
+            if let Some(a) = light.attenuation()
+                && a.model != AttenuationModel::Physical
+            {
+                let name = match a.model {
+                    AttenuationModel::Physical => "physical",
+                    AttenuationModel::Sphere => "sphere",
+                    AttenuationModel::Cutoff => "cutoff",
+                    AttenuationModel::WindowTan => "window_tan",
+                    AttenuationModel::WindowRational => "window_rational",
+                    AttenuationModel::WindowUe4 => "window_ue4",
+                };
+                return Err(format!(
+                    "the analytic integrator integrates the physical inverse-square falloff only; lights[{i}] \
+                     has attenuation = \"{name}\": use raymarch, or attenuation = \"physical\""
+                ));
+            }
             let point = |position: Vec3, intensity: Rgb, emission, gap| PointEmitter {
                 position: position.as_dvec3(),
                 intensity: intensity.as_dvec3(),
@@ -251,8 +294,8 @@ impl Analytic {
         }
         emitters.retain(|e| e.intensity != DVec3::ZERO);
         extended.retain(|e| e.intensity() != DVec3::ZERO);
-        let meshes = scene.geometry.occluders().any(|(o, _)| matches!(o, Occluder::Triangle { .. }));
-        Ok(Analytic { options, emitters, extended, rule, meshes })
+        let (blockers, meshes) = blockers::blockers(&scene.geometry);
+        Ok(Analytic { options, emitters, extended, rule, blockers, meshes })
     }
 
     /// Single-scattered radiance along `ray` over [0, t_end] from all lights.
@@ -263,25 +306,35 @@ impl Analytic {
         let o = ray.origin.as_dvec3();
         let d = ray.dir.as_dvec3().normalize();
         let consts = MediumConsts::new(medium);
-        let mut scratch = Scratch::default();
-        let mut total = DVec3::ZERO;
         let t_end = t_end as f64;
-        for e in &self.emitters {
-            total += self.emitter_light(scene, &consts, o, d, t_end, e, &mut scratch);
+        // Buffers reused across rays on this thread (a fresh set if nested).
+        thread_local! {
+            static SCRATCH: std::cell::RefCell<Scratch> = std::cell::RefCell::new(Scratch::default());
         }
-        for x in &self.extended {
-            let mut each = |e: &PointEmitter| {
-                total += self.emitter_light(scene, &consts, o, d, t_end, e, &mut scratch);
-            };
-            match *x {
-                Extended::Line { start, end, intensity, light } => {
-                    self.line_pieces(o, d, t_end, (start, end), intensity, light, 0, &mut each)
-                }
-                Extended::Quad { corner, edge_u, edge_v, normal, intensity, light } => {
-                    self.quad_pieces(o, d, t_end, (corner, edge_u, edge_v), normal, intensity, light, 0, &mut each)
+        let run = |scratch: &mut Scratch| {
+            let mut total = DVec3::ZERO;
+            for e in &self.emitters {
+                total += self.emitter_light(scene, &consts, o, d, t_end, e, scratch);
+            }
+            for x in &self.extended {
+                let mut each = |e: &PointEmitter| {
+                    total += self.emitter_light(scene, &consts, o, d, t_end, e, scratch);
+                };
+                match *x {
+                    Extended::Line { start, end, intensity, light } => {
+                        self.line_pieces(o, d, t_end, (start, end), intensity, light, 0, &mut each)
+                    }
+                    Extended::Quad { corner, edge_u, edge_v, normal, intensity, light } => {
+                        self.quad_pieces(o, d, t_end, (corner, edge_u, edge_v), normal, intensity, light, 0, &mut each)
+                    }
                 }
             }
-        }
+            total
+        };
+        let total = SCRATCH.with(|s| match s.try_borrow_mut() {
+            Ok(mut s) => run(&mut s),
+            Err(_) => run(&mut Scratch::default()),
+        });
         (total * medium.sigma_s.as_dvec3()).as_vec3()
     }
 
@@ -298,7 +351,9 @@ impl Analytic {
         s: &mut Scratch,
     ) -> DVec3 {
         let p = e.position;
-        let glows: [Glow; 3] = std::array::from_fn(|c| Glow::new(k.sigma_t[c], p, o, d, t_end));
+        let first = Glow::new(k.sigma_t[0], p, o, d, t_end);
+        let glows: [Glow; 3] =
+            std::array::from_fn(|c| if c < k.channels { Glow { sigma_t: k.sigma_t[c], ..first } } else { first });
         let range = (0.0, t_end);
         s.cuts.clear();
         s.cuts.push(0.0);
@@ -315,7 +370,16 @@ impl Analytic {
                 plane_boundaries(p, normal, o, d, range, &mut s.cuts);
             }
         }
-        if self.options.shadows {
+        let exact_shadows = self.options.shadows && !self.meshes;
+        if exact_shadows {
+            self.shadow_intervals(e, o, d, range, &mut s.cands, &mut s.shadow);
+            if s.shadow.first().is_some_and(|&(a, b)| a <= 0.0 && b >= t_end) {
+                return DVec3::ZERO;
+            }
+            for &(a, b) in &s.shadow {
+                s.cuts.extend([a, b].into_iter().filter(|&t| t > 0.0 && t < t_end));
+            }
+        } else if self.options.shadows {
             self.shadow_boundaries(scene, e, o, d, range, &mut s.cuts);
         }
         s.cuts.sort_unstable_by(f64::total_cmp);
@@ -328,17 +392,23 @@ impl Analytic {
             if tb <= ta {
                 continue;
             }
-            let x = o + d * (0.5 * (ta + tb));
-            let Some(constant) = self.modulation_class(scene, k, x, e) else {
+            let tm = 0.5 * (ta + tb);
+            let x = o + d * tm;
+            let Some(constant) = self.modulation_class(k, x, e) else {
                 continue;
             };
+            if exact_shadows && in_intervals(&s.shadow, tm)
+                || self.options.shadows && self.meshes && !visible(scene, x, e)
+            {
+                continue;
+            }
             let mut piece = [0.0; 3];
             for c in 0..k.channels {
                 let g = &glows[c];
                 if g.sigma_t > 0.0 {
                     for j in [i, i + 1] {
                         if s.k[j][c].is_nan() {
-                            s.k[j][c] = g.antiderivative(s.cuts[j]);
+                            s.k[j][c] = g.antiderivative_tabulated(s.cuts[j]);
                         }
                     }
                 }
@@ -360,6 +430,10 @@ impl Analytic {
 #[derive(Default)]
 struct Scratch {
     cuts: Vec<f64>,
+    /// One occluder's candidate shadow boundaries.
+    cands: Vec<f64>,
+    /// The ray's shadowed intervals for the current emitter.
+    shadow: Vec<(f64, f64)>,
     k: Vec<[f64; 3]>,
 }
 

@@ -3,26 +3,20 @@
 //! near-field factor; and the medium's numbers.
 
 use super::lights::sphere_factor;
-use super::{Analytic, Emission, MODULATED_POINTS, PointEmitter, quadrature, visible};
+use super::{Analytic, Emission, MODULATED_POINTS, PointEmitter, quadrature};
 use crate::integrator::analytic::closed_form::Glow;
 use crate::light::spot_falloff;
 use crate::medium::{Medium, henyey_greenstein};
-use crate::scene::Scene;
 use glam::DVec3;
 use std::f64::consts::FRAC_PI_4;
 
 impl Analytic {
     /// What multiplies the attenuation on the piece around `x`: None if the
-    /// piece is dark (outside a spot's cone, behind a quad light, in shadow),
+    /// piece is dark (outside a spot's cone, behind a quad light; shadows
+    /// are the caller's),
     /// Some(Some(m)) if phase·m is the constant m there, Some(None) if it
     /// varies (weighted_mean takes it).
-    pub(super) fn modulation_class(
-        &self,
-        scene: &Scene,
-        k: &MediumConsts,
-        x: DVec3,
-        e: &PointEmitter,
-    ) -> Option<Option<f64>> {
+    pub(super) fn modulation_class(&self, k: &MediumConsts, x: DVec3, e: &PointEmitter) -> Option<Option<f64>> {
         let to = e.position - x;
         let dist = to.length();
         if dist == 0.0 {
@@ -46,9 +40,6 @@ impl Analytic {
                 varies = true;
             }
             Emission::Sphere { .. } => varies = true,
-        }
-        if self.options.shadows && !visible(scene, x, e) {
-            return None;
         }
         Some(if varies { None } else { Some(henyey_greenstein(0.0, 0.0) as f64) })
     }

@@ -8,15 +8,17 @@
 //! r_l hold each channel's unidirectional and light-sampling path pdfs
 //! relative to the hero's).
 
+mod nee;
 pub mod tracking;
 
 use super::Integrator;
 use crate::Rgb;
 use crate::geometry::{Ray, offset_origin};
-use crate::medium::{Density, Medium, henyey_greenstein, sample_henyey_greenstein_cos};
-use crate::sampling::{Sampler, keyed2, to_world};
+use crate::medium::{henyey_greenstein, sample_henyey_greenstein_cos};
+use crate::sampling::{Sampler, to_world};
 use crate::scene::Scene;
 use glam::Vec3;
+use nee::{Along, Segment, direct_light, equiangular_applies, equiangular_light};
 use tracking::track;
 
 /// Volumetric path tracer. `max_depth` counts scattering events: 1 is direct
@@ -24,18 +26,29 @@ use tracking::track;
 /// maxdepth 1).
 pub struct PathTracer {
     pub max_depth: u32,
+    /// Also sample delta lights' scattered light equiangularly along each
+    /// segment through a homogeneous medium, with MIS (nee.rs). On by
+    /// default; off is free-flight sampling alone, as Mitsuba's volpath.
+    pub equiangular: bool,
 }
 
-/// Where light scatters: a surface or a point in the medium.
-enum Vertex {
+impl PathTracer {
+    pub fn new(max_depth: u32) -> Self {
+        PathTracer { max_depth, equiangular: true }
+    }
+}
+
+/// Where light scatters: a surface or a point in the medium (with its
+/// place on an equiangularly sampled segment, if any).
+enum Vertex<'a> {
     Surface { p: Vec3, n: Vec3, material: u32 },
-    Medium { p: Vec3 },
+    Medium { p: Vec3, along: Option<Along<'a>> },
 }
 
-impl Vertex {
+impl Vertex<'_> {
     fn p(&self) -> Vec3 {
         match *self {
-            Vertex::Surface { p, .. } | Vertex::Medium { p } => p,
+            Vertex::Surface { p, .. } | Vertex::Medium { p, .. } => p,
         }
     }
 }
@@ -60,6 +73,14 @@ impl Integrator for PathTracer {
                 // The medium scatters within max_distance along a ray (as the
                 // ray marcher); beyond it a far surface is only attenuated.
                 let t_medium = t_hit.min(max_distance);
+                // Delta lights' light scattered along the segment, also from
+                // equiangular points (nee.rs), when a scattering event here
+                // would still count.
+                let segment = Segment { ray, length: t_medium };
+                let equiangular = self.equiangular && depth < self.max_depth && equiangular_applies(m);
+                if equiangular {
+                    l += equiangular_light(scene, m, &segment, beta, r_u, hero, sampler);
+                }
                 let mut scattered: Option<Ray> = None;
                 let mut terminated = false;
                 let t_maj = track(m, &ray, t_medium, hero, sampler, |c, sampler| {
@@ -76,6 +97,7 @@ impl Integrator for PathTracer {
                         }
                         depth += 1;
                         let pdf = c.t_maj[hero] * c.sigma_s[hero];
+                        let along = equiangular.then(|| Along { segment: &segment, t: c.t, r_equiangular: r_u / pdf });
                         beta *= c.t_maj * c.sigma_s / pdf;
                         r_u *= c.t_maj * c.sigma_s / pdf;
                         if beta.max_element() <= 0.0 || r_u.max_element() <= 0.0 {
@@ -84,7 +106,8 @@ impl Integrator for PathTracer {
                         }
                         let p = ray.at(c.t);
                         let wo = -ray.dir;
-                        l += beta * direct_light(scene, m.into(), &Vertex::Medium { p }, wo, r_u, hero, sampler);
+                        let vertex = Vertex::Medium { p, along };
+                        l += beta * direct_light(scene, m.into(), &vertex, wo, r_u, hero, sampler);
                         // Phase sampling: its weight p/pdf is 1.
                         let cos = sample_henyey_greenstein_cos(m.g, sampler.next());
                         let sin = (1.0 - cos * cos).max(0.0).sqrt();
@@ -181,96 +204,4 @@ fn russian_roulette(beta: &mut Rgb, r_u: Rgb, depth: u32, sampler: &mut Sampler)
         *beta /= 1.0 - q;
     }
     true
-}
-
-/// Next-event estimation at a vertex: a sample of every light that reaches
-/// it, with a shadow ray and the medium's transmittance, weighted by the
-/// balance heuristic against sampling the BRDF or phase function. Returns
-/// the contribution to be multiplied by the path weight β.
-fn direct_light(
-    scene: &Scene,
-    medium: Option<&Medium>,
-    vertex: &Vertex,
-    wo: Vec3,
-    r_p: Rgb,
-    hero: usize,
-    sampler: &mut Sampler,
-) -> Rgb {
-    let p = vertex.p();
-    let key = sampler.next_key();
-    let mut total = Rgb::ZERO;
-    scene.for_each_light_at(p, |index, light| {
-        let Some(ls) = light.sample(p, keyed2(key, index as u64)) else { return };
-        let (f, scatter_pdf, origin) = match *vertex {
-            Vertex::Surface { p, n, material } => {
-                let m = &scene.materials[material as usize];
-                let f = m.brdf(p, n, wo, ls.wi) * ls.wi.dot(n).abs();
-                (f, m.pdf(p, n, wo, ls.wi), offset_origin(p, n, ls.wi))
-            }
-            Vertex::Medium { p } => {
-                let phase = medium.map_or(0.0, |m| m.phase(wo, ls.wi));
-                (Rgb::splat(phase), phase, p)
-            }
-        };
-        if f == Rgb::ZERO || ls.weight == Rgb::ZERO {
-            return;
-        }
-        let distance = scene.light_distance(ls.distance);
-        if scene.geometry.occluded(origin, ls.wi, scene.shadow_span(p, origin, ls.wi, ls.distance)) {
-            return;
-        }
-        let (mut t_ray, mut r_l, mut r_u) = (Rgb::ONE, Rgb::ONE, Rgb::ONE);
-        if let Some(m) = medium {
-            let shadow = Ray::new(origin, ls.wi);
-            match m.density {
-                // Exact transmittance where it is cheap. The MIS ratios get
-                // T/T[hero], the expected factor of ratio tracking, so that
-                // both strategies' pdfs carry the transmittance per channel
-                // as they do at emitter hits.
-                Density::Homogeneous => {
-                    t_ray = m.transmittance(origin, ls.wi, 0.0, distance);
-                    if t_ray[hero] <= 0.0 {
-                        return;
-                    }
-                    r_l = t_ray / t_ray[hero];
-                    r_u = r_l;
-                }
-                Density::Height { .. } => {
-                    let t_maj = track(m, &shadow, distance, hero, sampler, |c, sampler| {
-                        let sigma_n = (c.sigma_maj - c.sigma_a - c.sigma_s).max(Rgb::ZERO);
-                        let pdf = c.t_maj[hero] * c.sigma_maj[hero];
-                        t_ray *= c.t_maj * sigma_n / pdf;
-                        r_l *= c.t_maj * c.sigma_maj / pdf;
-                        r_u *= c.t_maj * sigma_n / pdf;
-                        // Roulette on small transmittance.
-                        let tr = t_ray / avg(r_l + r_u);
-                        if tr.max_element() < 0.05 {
-                            if sampler.next() < 0.75 {
-                                t_ray = Rgb::ZERO;
-                            } else {
-                                t_ray /= 0.25;
-                            }
-                        }
-                        t_ray.max_element() > 0.0
-                    });
-                    t_ray *= t_maj / t_maj[hero];
-                    r_l *= t_maj / t_maj[hero];
-                    r_u *= t_maj / t_maj[hero];
-                }
-            }
-        }
-        if t_ray == Rgb::ZERO {
-            return;
-        }
-        if ls.pdf == 0.0 {
-            // A delta light: nothing else can find it.
-            total += f * t_ray * ls.weight / avg(r_p * r_l);
-        } else {
-            let radiance = ls.weight * ls.pdf;
-            let r_l = r_p * r_l * ls.pdf;
-            let r_u = r_p * r_u * scatter_pdf;
-            total += f * t_ray * radiance / avg(r_l + r_u);
-        }
-    });
-    total
 }

@@ -1,0 +1,351 @@
+//! `airlight render`: one image, progressive passes (optionally until an
+//! error target), or the numbered frames of a light animation.
+
+use crate::load;
+use airlight::film::Image;
+use airlight::integrator::analytic::LightQuadrature;
+use airlight::integrator::{self, IntegratorKind, Sampling};
+use airlight::render::{Progressive, RenderObserver, render_with};
+use airlight::scene::{LightCulling, Scene};
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+#[derive(clap::Args)]
+pub struct RenderArgs {
+    /// Scene file (TOML). Without one, the built-in demo scene.
+    scene: Option<PathBuf>,
+    /// Output image, .png or .exr; may be given more than once.
+    /// Default: airlight.png for the demo, else the scene's name with .png.
+    #[arg(short, long = "output", value_name = "OUT")]
+    output: Vec<PathBuf>,
+    /// Integrator: direct, raymarch, analytic, stochastic, path, radiosity.
+    #[arg(long)]
+    integrator: Option<IntegratorKind>,
+    /// Stochastic: how points on the camera segment are drawn: uniform,
+    /// equiangular or mis.
+    #[arg(long)]
+    sampling: Option<Sampling>,
+    /// Stochastic: independent random samples instead of stratified ones.
+    #[arg(long)]
+    no_stratify: bool,
+    /// Render in passes of 1, 1, 2, 4, ... samples per pixel up to spp,
+    /// rewriting the output after each pass.
+    #[arg(long)]
+    progressive: bool,
+    /// Stop once the estimated relative error of the image (√(Σ variance of
+    /// the pixel means / Σ mean²)) is below E, or at spp; implies
+    /// --progressive. The estimate is close for independent samples, high
+    /// for stratified ones (stochastic), and low while rare bright samples
+    /// (fireflies) are still missing.
+    #[arg(long, value_name = "E", value_parser = parse_target_error)]
+    target_error: Option<f64>,
+    /// Also write the estimated variance of each pixel's mean (per channel)
+    /// as an EXR; implies --progressive.
+    #[arg(long, value_name = "OUT.exr")]
+    variance: Option<PathBuf>,
+    /// Render N frames of the scene's light animation (lights with
+    /// keyframes), frame k at time k/(N − 1), each output numbered:
+    /// NAME_0000.png, NAME_0001.png, ...
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..))]
+    frames: Option<u32>,
+    /// Samples per pixel.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
+    spp: Option<u32>,
+    /// March samples per ray.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
+    steps: Option<u32>,
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
+    width: Option<u32>,
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
+    height: Option<u32>,
+    #[arg(long)]
+    seed: Option<u64>,
+    /// Falloff for every point, spot and sphere light: physical, sphere,
+    /// cutoff, window_tan, window_rational, window_ue4 (each keeps its cutoff).
+    #[arg(long, value_parser = parse_attenuation)]
+    attenuation: Option<airlight::light::AttenuationModel>,
+    /// analytic: volumetric shadows (the lit intervals of each ray).
+    #[arg(long)]
+    shadows: bool,
+    /// analytic: points per dimension over line and quad lights.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=4096))]
+    light_steps: Option<u32>,
+    /// analytic: gauss (Gauss–Legendre) or uniform (the seed's stepping) over lights.
+    #[arg(long, value_parser = parse_light_quadrature)]
+    light_quadrature: Option<LightQuadrature>,
+    /// Worker threads (default: all cores). The image does not depend on it.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
+    threads: Option<u32>,
+    /// No progress bar or summary.
+    #[arg(long, short)]
+    quiet: bool,
+}
+
+/// Where one frame goes: its images and, on request, its variance.
+struct FrameOutputs {
+    images: Vec<PathBuf>,
+    variance: Option<PathBuf>,
+}
+
+pub fn render(args: RenderArgs) -> Result<(), String> {
+    let scene = configure(&args)?;
+    let outputs = output_paths(&args)?;
+    if let Some(v) = &args.variance
+        && !v.extension().is_some_and(|e| e.eq_ignore_ascii_case("exr"))
+    {
+        return Err(format!("cannot write `{}`: the variance is written as .exr", v.display()));
+    }
+    if args.frames.is_some() && !scene.is_animated() {
+        return Err("--frames: the scene has no light with keyframes to animate".into());
+    }
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(args.threads.unwrap_or(0) as usize)
+        .build()
+        .map_err(|e| format!("cannot start worker threads: {e}"))?;
+    let progressive = args.progressive || args.target_error.is_some() || args.variance.is_some();
+    let frames = args.frames.unwrap_or(1);
+    let s = &scene.settings;
+    let pixels = s.width as u64 * s.height as u64;
+    let per_frame = if progressive { pixels * s.spp as u64 } else { pixels };
+    let bar = if args.quiet {
+        ProgressBar::hidden()
+    } else {
+        ProgressBar::with_draw_target(Some(per_frame * frames as u64), ProgressDrawTarget::stderr())
+    };
+    if let Ok(style) = ProgressStyle::with_template("{spinner} {msg} [{bar:40}] {percent}% {elapsed} (eta {eta})") {
+        bar.set_style(style.progress_chars("=> "));
+    }
+    let start = Instant::now();
+    let mut scene = scene;
+    let mut written = Vec::new();
+    for frame in 0..frames {
+        let outputs = match args.frames {
+            Some(_) => {
+                let time = if frames > 1 { frame as f32 / (frames - 1) as f32 } else { 0.0 };
+                scene.lights = scene.lights_at(time);
+                scene.light_culling = LightCulling::new(&scene.lights);
+                FrameOutputs {
+                    images: outputs.iter().map(|p| numbered(p, frame)).collect(),
+                    variance: args.variance.as_deref().map(|p| numbered(p, frame)),
+                }
+            }
+            None => FrameOutputs { images: outputs.clone(), variance: args.variance.clone() },
+        };
+        let frame_label = args.frames.map(|n| format!(" frame {}/{n}", frame + 1)).unwrap_or_default();
+        let summary = if progressive {
+            render_progressive(&scene, &pool, &bar, &outputs, args.target_error, &frame_label)?
+        } else {
+            render_once(&scene, &pool, &bar, &outputs, &frame_label)?
+        };
+        if !args.quiet && args.frames.is_none() && !summary.is_empty() {
+            bar.suspend(|| eprintln!("{summary}"));
+        }
+        written.extend(outputs.images.iter().map(|p| p.display().to_string()));
+        written.extend(outputs.variance.iter().map(|p| p.display().to_string()));
+    }
+    let elapsed = start.elapsed();
+    bar.finish_and_clear();
+    if !args.quiet {
+        let s = &scene.settings;
+        let what = match args.frames {
+            Some(n) => format!("{n} frames of {}×{}", s.width, s.height),
+            None => format!("{}×{}", s.width, s.height),
+        };
+        let shown = if written.len() > 4 {
+            format!("{}, …, {}", written[0], written[written.len() - 1])
+        } else {
+            written.join(", ")
+        };
+        eprintln!("rendered {what} in {:.2} s → {shown}", elapsed.as_secs_f64());
+    }
+    Ok(())
+}
+
+/// The scene with the command line's overrides applied.
+fn configure(args: &RenderArgs) -> Result<Scene, String> {
+    let mut scene = load(args.scene.as_deref())?;
+    let s = &mut scene.settings;
+    if let Some(v) = args.integrator {
+        s.integrator = v;
+    }
+    if let Some(v) = args.spp {
+        s.spp = v;
+    }
+    if let Some(v) = args.steps {
+        s.steps = v;
+    }
+    if let Some(v) = args.width {
+        s.width = v;
+    }
+    if let Some(v) = args.height {
+        s.height = v;
+    }
+    if let Some(v) = args.seed {
+        s.seed = v;
+    }
+    if let Some(v) = args.sampling {
+        s.sampling = v;
+    }
+    if args.no_stratify {
+        s.stratify = false;
+    }
+    if let Some(model) = args.attenuation {
+        for light in &mut scene.lights {
+            if let Some(a) = light.attenuation() {
+                let a = a.with_model(model).map_err(|e| format!("--attenuation: {e}"))?;
+                *light = light.with_attenuation(a);
+            }
+        }
+        scene.light_culling = LightCulling::new(&scene.lights);
+    }
+    if args.shadows {
+        s.shadows = true;
+    }
+    if let Some(v) = args.light_steps {
+        s.light_steps = v;
+    }
+    if let Some(v) = args.light_quadrature {
+        s.light_quadrature = v;
+    }
+    Ok(scene)
+}
+
+/// The image outputs: as given, or NAME.png after the scene file.
+fn output_paths(args: &RenderArgs) -> Result<Vec<PathBuf>, String> {
+    let outputs = if args.output.is_empty() {
+        vec![match &args.scene {
+            Some(path) => PathBuf::from(path.file_stem().unwrap_or_default()).with_extension("png"),
+            None => PathBuf::from("airlight.png"),
+        }]
+    } else {
+        args.output.clone()
+    };
+    for out in &outputs {
+        match out.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref() {
+            Some("png" | "exr") => {}
+            _ => {
+                return Err(format!("cannot write `{}`: the output must end in .png or .exr", out.display()));
+            }
+        }
+    }
+    Ok(outputs)
+}
+
+/// `path` with `_NNNN` (the frame number) before its extension.
+fn numbered(path: &Path, frame: u32) -> PathBuf {
+    let stem = path.file_stem().unwrap_or_default().to_string_lossy();
+    let name = match path.extension() {
+        Some(ext) => format!("{stem}_{frame:04}.{}", ext.to_string_lossy()),
+        None => format!("{stem}_{frame:04}"),
+    };
+    path.with_file_name(name)
+}
+
+fn write_images(scene: &Scene, image: &Image, outputs: &[PathBuf]) -> Result<(), String> {
+    let s = &scene.settings;
+    for out in outputs {
+        image.write(out, s.exposure, s.tonemap).map_err(|e| format!("cannot write `{}`: {e}", out.display()))?;
+    }
+    Ok(())
+}
+
+/// All samples in one go; returns nothing to report.
+fn render_once(
+    scene: &Scene,
+    pool: &rayon::ThreadPool,
+    bar: &ProgressBar,
+    outputs: &FrameOutputs,
+    frame_label: &str,
+) -> Result<String, String> {
+    let integrator = integrator::for_scene(scene)?;
+    let s = &scene.settings;
+    bar.set_message(format!("{} {}×{} {} spp{frame_label}", s.integrator, s.width, s.height, s.spp));
+    let progress = |n: u64| bar.inc(n);
+    let observer = RenderObserver { progress: Some(&progress), cancel: None };
+    let image = pool.install(|| render_with(scene, integrator.as_ref(), &observer));
+    write_images(scene, &image, &outputs.images)?;
+    Ok(String::new())
+}
+
+/// Passes of doubling size, each rewriting the outputs (atomically, so
+/// stopping the render loses at most the pass under way), until spp or the
+/// error target; returns the samples reached and the estimated error.
+fn render_progressive(
+    scene: &Scene,
+    pool: &rayon::ThreadPool,
+    bar: &ProgressBar,
+    outputs: &FrameOutputs,
+    target_error: Option<f64>,
+    frame_label: &str,
+) -> Result<String, String> {
+    let integrator = integrator::for_scene(scene)?;
+    let s = &scene.settings;
+    let mut progressive = Progressive::new(scene);
+    let mut error = f64::INFINITY;
+    while !progressive.finished() && !target_error.is_some_and(|target| error < target) {
+        let count = progressive.next_pass_size() as u64;
+        let progress = |n: u64| bar.inc(n * count);
+        let observer = RenderObserver { progress: Some(&progress), cancel: None };
+        pool.install(|| progressive.pass(scene, integrator.as_ref(), &observer));
+        error = progressive.estimated_relative_error();
+        bar.set_message(format!(
+            "{} {}×{} {}/{} spp, est. error {}{frame_label}",
+            s.integrator,
+            s.width,
+            s.height,
+            progressive.samples(),
+            s.spp,
+            format_error(error),
+        ));
+        write_images(scene, &progressive.image(), &outputs.images)?;
+        // The variance is known from the second sample on (EXR: linear, the
+        // tone map is not applied).
+        if let Some(path) = outputs.variance.as_ref().filter(|_| progressive.samples() >= 2) {
+            progressive
+                .variance()
+                .write(path, 1.0, s.tonemap)
+                .map_err(|e| format!("cannot write `{}`: {e}", path.display()))?;
+        }
+    }
+    // Samples skipped by reaching the target still count toward the bar.
+    let skipped = (s.spp - progressive.samples()) as u64 * s.width as u64 * s.height as u64;
+    bar.inc(skipped);
+    Ok(format!("{} spp, estimated relative error {}", progressive.samples(), format_error(error)))
+}
+
+fn format_error(error: f64) -> String {
+    if error.is_finite() { format!("{error:.4}") } else { "unknown (fewer than 2 samples)".into() }
+}
+
+fn parse_target_error(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(e) if e > 0.0 && e.is_finite() => Ok(e),
+        _ => Err(format!("`{s}` is not a positive number (a relative error, e.g. 0.01)")),
+    }
+}
+
+fn parse_light_quadrature(s: &str) -> Result<LightQuadrature, String> {
+    match s {
+        "gauss" => Ok(LightQuadrature::Gauss),
+        "uniform" => Ok(LightQuadrature::Uniform),
+        _ => Err(format!("unknown light quadrature `{s}`; expected gauss or uniform")),
+    }
+}
+
+fn parse_attenuation(s: &str) -> Result<airlight::light::AttenuationModel, String> {
+    use airlight::light::AttenuationModel as M;
+    Ok(match s {
+        "physical" => M::Physical,
+        "sphere" => M::Sphere,
+        "cutoff" => M::Cutoff,
+        "window_tan" => M::WindowTan,
+        "window_rational" => M::WindowRational,
+        "window_ue4" => M::WindowUe4,
+        _ => {
+            return Err(format!(
+                "unknown attenuation `{s}`; expected physical, sphere, cutoff, window_tan, window_rational or window_ue4"
+            ));
+        }
+    })
+}

@@ -1,0 +1,96 @@
+//! `airlight render` with --frames (light animation), --target-error and
+//! --variance.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn airlight(dir: &Path, args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_airlight")).current_dir(dir).args(args).output().unwrap()
+}
+
+fn scene(name: &str) -> String {
+    let path: PathBuf = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes").join(name);
+    path.to_str().unwrap().to_string()
+}
+
+fn names(dir: &Path) -> Vec<String> {
+    let mut names: Vec<String> =
+        std::fs::read_dir(dir).unwrap().map(|e| e.unwrap().file_name().into_string().unwrap()).collect();
+    names.sort();
+    names
+}
+
+#[test]
+fn frames_are_numbered_and_follow_the_moving_lights() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = scene("room_moving_lights.toml");
+    let size = ["--width", "32", "--height", "24", "--spp", "2", "--quiet"];
+    let run = airlight(dir.path(), &[&["render", &scene, "--frames", "3", "-o", "room.exr"][..], &size].concat());
+    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+    assert_eq!(names(dir.path()), ["room_0000.exr", "room_0001.exr", "room_0002.exr"]);
+    let frames: Vec<Vec<u8>> =
+        (0..3).map(|k| std::fs::read(dir.path().join(format!("room_{k:04}.exr"))).unwrap()).collect();
+    // The lights move, so every frame differs from the others.
+    assert!(frames[0] != frames[1] && frames[1] != frames[2] && frames[0] != frames[2]);
+    // Frame 0 is the animation at time 0, rendered again the same way.
+    let again = airlight(dir.path(), &[&["render", &scene, "--frames", "1", "-o", "again.exr"][..], &size].concat());
+    assert!(again.status.success());
+    assert!(std::fs::read(dir.path().join("again_0000.exr")).unwrap() == frames[0]);
+}
+
+#[test]
+fn frames_of_a_still_scene_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = airlight(dir.path(), &["render", &scene("glow.toml"), "--frames", "4", "--quiet"]);
+    assert!(!run.status.success());
+    assert!(String::from_utf8_lossy(&run.stderr).contains("no light with keyframes"));
+    assert!(names(dir.path()).is_empty());
+}
+
+#[test]
+fn target_error_stops_early_and_writes_the_variance() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = airlight(
+        dir.path(),
+        &[
+            "render",
+            "--width",
+            "48",
+            "--height",
+            "36",
+            "--spp",
+            "4096",
+            "--target-error",
+            "0.1",
+            "--variance",
+            "var.exr",
+            "-o",
+            "demo.exr",
+        ],
+    );
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert!(run.status.success(), "{stderr}");
+    assert_eq!(names(dir.path()), ["demo.exr", "var.exr"]);
+    // "N spp, estimated relative error E": stopped before 4096 with E < 0.1.
+    let line = stderr.lines().find(|l| l.contains("estimated relative error")).expect("a summary line");
+    let spp: u32 = line.split(" spp").next().unwrap().trim().parse().unwrap();
+    let error: f64 = line.rsplit(' ').next().unwrap().parse().unwrap();
+    assert!(spp < 4096 && error < 0.1, "{line}");
+}
+
+#[test]
+fn bad_convergence_options_are_refused_before_rendering() {
+    let dir = tempfile::tempdir().unwrap();
+    for args in [
+        &["render", "--target-error", "0"][..],
+        &["render", "--target-error", "-0.1"],
+        &["render", "--target-error", "nan"],
+        &["render", "--variance", "var.png"],
+        &["render", "--frames", "0"],
+    ] {
+        let out = airlight(dir.path(), args);
+        assert!(!out.status.success(), "{args:?} should fail");
+        assert!(!out.stderr.is_empty());
+    }
+    assert!(names(dir.path()).is_empty(), "nothing written");
+}

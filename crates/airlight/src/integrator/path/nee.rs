@@ -1,0 +1,221 @@
+//! Next-event estimation: light sampled from a vertex, and light sampled
+//! along a segment of a ray through a homogeneous medium.
+//!
+//! Near a point or spot light in a medium the single-scattered light grows
+//! as 1/r², and a collision found by free-flight sampling lands there too
+//! rarely: the variance of that estimator is infinite (∫ r⁻⁴ r² dr diverges
+//! at the light), which shows as fireflies that never average out. So each
+//! segment also gets, per delta light, a point drawn equiangularly about the
+//! light (Kulla and Fajardo, "Importance Sampling Techniques for Path Tracing
+//! in Participating Media", EGSR 2012), and the two estimates of the light
+//! scattered along the segment are combined by the balance heuristic
+//! (Veach 1997). With the hero-channel weights of mod.rs, both strategies'
+//! densities of the scattering point at t, relative to the hero path's
+//! prefix, are r_u,c·σs,c·T_c(t) (free flight in channel c) and r_u,c·p_eq(t)
+//! (equiangular), so either sample contributes
+//! β·σs·T(t)·f_phase·T_light·I/r² / avg_c(r_u,c·r_l,c·(σs,c·T_c(t) + p_eq(t))),
+//! r_l the shadow ray's transmittance ratios.
+
+use super::tracking::track;
+use super::{Vertex, avg};
+use crate::Rgb;
+use crate::geometry::{Ray, offset_origin};
+use crate::integrator::Equiangular;
+use crate::light::Light;
+use crate::medium::{Density, Medium};
+use crate::sampling::{Sampler, keyed2};
+use crate::scene::Scene;
+use glam::Vec3;
+
+/// A ray's stretch [0, length] through a homogeneous medium.
+#[derive(Clone, Copy)]
+pub(super) struct Segment {
+    pub ray: Ray,
+    pub length: f32,
+}
+
+impl Segment {
+    /// The equiangular distribution of the segment about `light`, for the
+    /// lights it applies to: point, spot and line lights (delta lights with
+    /// a place; a line's centre, spread by its length).
+    fn equiangular(&self, light: &Light) -> Option<Equiangular> {
+        if !light.is_delta() {
+            return None;
+        }
+        let (y, spread) = light.anchor()?;
+        Some(Equiangular::new(self.ray.origin, self.ray.dir, y, spread, 0.0, self.length))
+    }
+
+    /// Whether the segment passes within `radius` of `center`.
+    fn passes_within(&self, center: Vec3, radius: f32) -> bool {
+        let t = (center - self.ray.origin).dot(self.ray.dir).clamp(0.0, self.length);
+        self.ray.at(t).distance_squared(center) <= radius * radius
+    }
+}
+
+/// A free-flight collision's place on its segment, for the balance
+/// heuristic: its distance t and r_u/pdf (the prefix's channel ratios over
+/// the hero's free-flight density at t), which turns p_eq(t) into the units
+/// of the collision's own r_u.
+pub(super) struct Along<'a> {
+    pub segment: &'a Segment,
+    pub t: f32,
+    pub r_equiangular: Rgb,
+}
+
+/// The light of the delta lights scattered along `segment` toward its
+/// origin, from one equiangular point per light, weighted by the balance
+/// heuristic against free-flight collisions (module notes); `beta` and
+/// `r_u` are the path's at the segment's start, and the result includes β.
+pub(super) fn equiangular_light(
+    scene: &Scene,
+    medium: &Medium,
+    segment: &Segment,
+    beta: Rgb,
+    r_u: Rgb,
+    hero: usize,
+    sampler: &mut Sampler,
+) -> Rgb {
+    let key = sampler.next_key();
+    let wo = -segment.ray.dir;
+    let mut total = Rgb::ZERO;
+    for (index, light) in scene.lights.iter().enumerate() {
+        let Some(equiangular) = segment.equiangular(light) else { continue };
+        if light.reach().is_some_and(|(center, radius)| !segment.passes_within(center, radius)) {
+            continue;
+        }
+        let u = keyed2(key, 2 * index as u64);
+        let t = equiangular.sample(u.x);
+        let pdf = equiangular.pdf(t);
+        let p = segment.ray.at(t);
+        let Some(ls) = light.sample(p, keyed2(key, 2 * index as u64 + 1)) else { continue };
+        let phase = medium.phase(wo, ls.wi);
+        if pdf <= 0.0 || !pdf.is_finite() || phase <= 0.0 || ls.weight == Rgb::ZERO {
+            continue;
+        }
+        if !scene.light_visible(p, p, ls.wi, ls.distance) {
+            continue;
+        }
+        let t_light = medium.transmittance(p, ls.wi, 0.0, scene.light_distance(ls.distance));
+        let t_view = medium.transmittance(segment.ray.origin, segment.ray.dir, 0.0, t);
+        if t_light[hero] <= 0.0 {
+            continue;
+        }
+        let r_l = t_light / t_light[hero];
+        let free_flight = medium.sigma_s * t_view;
+        let denominator = avg(r_u * r_l * (free_flight + Rgb::splat(pdf)));
+        total += beta * free_flight * t_light * ls.weight * (phase / denominator);
+    }
+    total
+}
+
+/// Whether equiangular sampling applies to a medium: homogeneous (where
+/// free-flight densities are closed form) and scattering.
+pub(super) fn equiangular_applies(medium: &Medium) -> bool {
+    matches!(medium.density, Density::Homogeneous) && medium.sigma_s.max_element() > 0.0
+}
+
+/// Next-event estimation at a vertex: a sample of every light that reaches
+/// it, with a shadow ray and the medium's transmittance, weighted by the
+/// balance heuristic against sampling the BRDF or phase function (area
+/// lights) or against equiangular sampling of the segment (delta lights,
+/// when the medium vertex knows its place on it). Returns the
+/// contribution to be multiplied by the path weight β.
+pub(super) fn direct_light(
+    scene: &Scene,
+    medium: Option<&Medium>,
+    vertex: &Vertex,
+    wo: Vec3,
+    r_p: Rgb,
+    hero: usize,
+    sampler: &mut Sampler,
+) -> Rgb {
+    let p = vertex.p();
+    let along = match vertex {
+        Vertex::Medium { along, .. } => along.as_ref(),
+        Vertex::Surface { .. } => None,
+    };
+    let key = sampler.next_key();
+    let mut total = Rgb::ZERO;
+    scene.for_each_light_at(p, |index, light| {
+        let Some(ls) = light.sample(p, keyed2(key, index as u64)) else { return };
+        let (f, scatter_pdf, origin) = match *vertex {
+            Vertex::Surface { p, n, material } => {
+                let m = &scene.materials[material as usize];
+                let f = m.brdf(p, n, wo, ls.wi) * ls.wi.dot(n).abs();
+                (f, m.pdf(p, n, wo, ls.wi), offset_origin(p, n, ls.wi))
+            }
+            Vertex::Medium { p, .. } => {
+                let phase = medium.map_or(0.0, |m| m.phase(wo, ls.wi));
+                (Rgb::splat(phase), phase, p)
+            }
+        };
+        if f == Rgb::ZERO || ls.weight == Rgb::ZERO {
+            return;
+        }
+        let distance = scene.light_distance(ls.distance);
+        if !scene.light_visible(p, origin, ls.wi, ls.distance) {
+            return;
+        }
+        let (mut t_ray, mut r_l, mut r_u) = (Rgb::ONE, Rgb::ONE, Rgb::ONE);
+        if let Some(m) = medium {
+            let shadow = Ray::new(origin, ls.wi);
+            match m.density {
+                // Exact transmittance where it is cheap. The MIS ratios get
+                // T/T[hero], the expected factor of ratio tracking, so that
+                // both strategies' pdfs carry the transmittance per channel
+                // as they do at emitter hits.
+                Density::Homogeneous => {
+                    t_ray = m.transmittance(origin, ls.wi, 0.0, distance);
+                    if t_ray[hero] <= 0.0 {
+                        return;
+                    }
+                    r_l = t_ray / t_ray[hero];
+                    r_u = r_l;
+                }
+                Density::Height { .. } => {
+                    let t_maj = track(m, &shadow, distance, hero, sampler, |c, sampler| {
+                        let sigma_n = (c.sigma_maj - c.sigma_a - c.sigma_s).max(Rgb::ZERO);
+                        let pdf = c.t_maj[hero] * c.sigma_maj[hero];
+                        t_ray *= c.t_maj * sigma_n / pdf;
+                        r_l *= c.t_maj * c.sigma_maj / pdf;
+                        r_u *= c.t_maj * sigma_n / pdf;
+                        // Roulette on small transmittance.
+                        let tr = t_ray / avg(r_l + r_u);
+                        if tr.max_element() < 0.05 {
+                            if sampler.next() < 0.75 {
+                                t_ray = Rgb::ZERO;
+                            } else {
+                                t_ray /= 0.25;
+                            }
+                        }
+                        t_ray.max_element() > 0.0
+                    });
+                    t_ray *= t_maj / t_maj[hero];
+                    r_l *= t_maj / t_maj[hero];
+                    r_u *= t_maj / t_maj[hero];
+                }
+            }
+        }
+        if t_ray == Rgb::ZERO {
+            return;
+        }
+        if ls.pdf == 0.0 {
+            // A delta light: found only by next-event estimation, from this
+            // collision or, on the same segment, from an equiangular point.
+            let mut denominator = avg(r_p * r_l);
+            if let Some(along) = along
+                && let Some(equiangular) = along.segment.equiangular(light)
+            {
+                denominator += avg(along.r_equiangular * r_l) * equiangular.pdf(along.t);
+            }
+            total += f * t_ray * ls.weight / denominator;
+        } else {
+            let radiance = ls.weight * ls.pdf;
+            let r_l = r_p * r_l * ls.pdf;
+            let r_u = r_p * r_u * scatter_pdf;
+            total += f * t_ray * radiance / avg(r_l + r_u);
+        }
+    });
+    total
+}
