@@ -10,6 +10,7 @@ use std::process::ExitCode;
 
 mod plot;
 mod render;
+mod view;
 
 /// The built-in demo scene: spheres on a checker floor under a spot light in fog.
 const DEMO_SCENE: &str = include_str!("../../../scenes/demo.toml");
@@ -35,6 +36,9 @@ enum Command {
     /// compile figures and per-frame milliseconds (median, p95) of
     /// direct + push + gather.
     Gi(GiArgs),
+    /// Fly through a scene and move its lights in a window (with none: the
+    /// built-in Cornell box), or replay a scripted path with --headless.
+    View(view::ViewArgs),
     /// Compare two EXR images: prints rmse, rel_mse, mae and max.
     Compare {
         image: PathBuf,
@@ -104,6 +108,7 @@ fn main() -> ExitCode {
         Command::Compare { image, reference, map } => compare(&image, &reference, map.as_deref()),
         Command::Attenuation(args) => attenuation(args),
         Command::Gi(args) => gi(args),
+        Command::View(args) => view::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -26,6 +26,7 @@ pub mod integrator;
 pub mod light;
 pub mod material;
 pub mod medium;
+pub mod preview;
 pub mod radiosity;
 pub mod render;
 pub mod sampling;

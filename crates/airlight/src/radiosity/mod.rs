@@ -306,6 +306,10 @@ impl Radiosity {
     pub fn links(&self) -> &Links {
         &self.links
     }
+    /// The grid that [`Radiosity::irradiance_at`] interpolates with.
+    pub fn lookup(&self) -> &Lookup {
+        &self.lookup
+    }
     /// Direct irradiance per patch from the last update.
     pub fn direct_irradiance(&self) -> &[Rgb] {
         &self.direct

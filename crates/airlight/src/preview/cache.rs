@@ -1,0 +1,328 @@
+//! The preview's first sample, cached across frames while the camera stands
+//! still: when only lights move, what each pixel's camera ray meets, and the
+//! radiosity lookup's weights there, stay the same. Keeping them leaves a
+//! frame one light sample with its shadow ray and a short weighted sum of
+//! patch irradiances per pixel.
+//!
+//! Area lights are surfaces the camera can see, and they move: the cache
+//! holds hits against the scene's objects only, and each frame tests the
+//! camera rays against the lights' surfaces where they are now.
+
+use super::Preview;
+use crate::Camera;
+use crate::Rgb;
+use crate::film::Image;
+use crate::geometry::{Geometry, GeometryBuilder, Ray, Shape, SurfaceHit};
+use crate::integrator::surface_radiance;
+use crate::light::Light;
+use crate::radiosity::Radiosity;
+use crate::sampling::Sampler;
+use crate::scene::{PixelFilter, Scene};
+use glam::Vec2;
+use rayon::prelude::*;
+use std::cell::RefCell;
+use std::f32::consts::FRAC_1_PI;
+
+/// One pixel's camera ray and what it meets among the objects.
+#[derive(Clone, Copy)]
+struct Texel {
+    ray: Ray,
+    hit: Option<SurfaceHit>,
+    /// The hit's distance, or how far the preview follows a ray that hits nothing.
+    t: f32,
+    /// The diffuse albedo at the hit, times 1/π.
+    albedo: Rgb,
+    /// Lookup weights: `weights[start..start + len]`, times `scale`.
+    start: u32,
+    len: u32,
+    scale: f32,
+}
+
+/// One image row's texels and the lookup weights they index.
+type Row = (Vec<Texel>, Vec<(u32, f32)>);
+
+/// What [`Camera`], size, seed and filter the cache was made for.
+type Key = (Camera, u32, u32, u64, PixelFilter);
+
+/// Sample 0 of every pixel of the preview, reusing camera-ray hits and
+/// lookup weights while the view stays the same (see the module docs).
+pub struct FirstSample {
+    key: Option<Key>,
+    /// The scene's objects without the lights' surfaces.
+    objects: Geometry,
+    texels: Vec<Texel>,
+    weights: Vec<(u32, f32)>,
+}
+
+impl FirstSample {
+    /// An empty cache for `scene` (whose objects must not change after).
+    pub fn new(scene: &Scene) -> Self {
+        let mut objects = GeometryBuilder::default();
+        for (shape, material) in &scene.objects {
+            objects.add(shape, *material, None);
+        }
+        FirstSample { key: None, objects: objects.build(), texels: Vec::new(), weights: Vec::new() }
+    }
+
+    /// Whether the next [`FirstSample::render`] reuses the cached hits.
+    pub fn is_valid_for(&self, scene: &Scene) -> bool {
+        self.key == Some(key(scene))
+    }
+
+    /// Sample 0 of every pixel with `preview` (which must hold `solution`
+    /// and be made for the scene's current lights): the image
+    /// `render_samples(scene, preview, 0, 1, ..)` gives, computed from the
+    /// cache, which is refilled first when the camera, image size, seed or
+    /// filter changed.
+    pub fn render(&mut self, scene: &Scene, solution: Option<&Radiosity>, preview: &Preview) -> Image {
+        if !self.is_valid_for(scene) {
+            self.fill(scene, solution);
+        }
+        let lights = light_surfaces(scene);
+        let (w, h) = (scene.settings.width, scene.settings.height);
+        let mut image = Image::new(w, h);
+        image.pixels.par_chunks_mut(w as usize).enumerate().for_each(|(y, row)| {
+            for (x, out) in row.iter_mut().enumerate() {
+                let index = y * w as usize + x;
+                *out = self.shade(scene, solution, preview, &lights, index);
+            }
+        });
+        image
+    }
+
+    fn fill(&mut self, scene: &Scene, solution: Option<&Radiosity>) {
+        let s = &scene.settings;
+        let (w, h) = (s.width as usize, s.height as usize);
+        let tmax = if scene.medium.is_some() { f32::INFINITY } else { s.max_distance };
+        let rows: Vec<Row> = (0..h)
+            .into_par_iter()
+            .map(|y| {
+                let mut texels = Vec::with_capacity(w);
+                let mut weights = Vec::new();
+                for x in 0..w {
+                    let mut sampler = first_sampler(scene, (y * w + x) as u64);
+                    let (jitter, lens) = (sampler.next2(), sampler.next2());
+                    let film = Vec2::new(x as f32, y as f32)
+                        + match s.filter {
+                            PixelFilter::Box => jitter,
+                            PixelFilter::Point => Vec2::splat(0.5),
+                        };
+                    let ray = scene.camera.ray(film, s.width, s.height, lens);
+                    let mut texel = Texel { ray, hit: None, t: tmax, albedo: Rgb::ZERO, start: 0, len: 0, scale: 0.0 };
+                    if let Some(hit) = self.objects.intersect(&ray, tmax) {
+                        let surface = self.objects.surface(&ray, hit);
+                        texel.hit = Some(surface);
+                        texel.t = hit.t;
+                        texel.albedo =
+                            scene.materials[surface.material as usize].albedo(surface.p, surface.n) * FRAC_1_PI;
+                        if let Some(solution) = solution {
+                            let n = if surface.n.dot(ray.dir) <= 0.0 { surface.n } else { -surface.n };
+                            texel.start = weights.len() as u32;
+                            if let Some(scale) = lookup_weights(solution, surface.p, n, &mut weights) {
+                                texel.len = weights.len() as u32 - texel.start;
+                                texel.scale = scale;
+                            }
+                        }
+                    }
+                    texels.push(texel);
+                }
+                (texels, weights)
+            })
+            .collect();
+        self.texels.clear();
+        self.weights.clear();
+        for (texels, weights) in rows {
+            let base = self.weights.len() as u32;
+            self.texels.extend(texels.into_iter().map(|t| Texel { start: t.start + base, ..t }));
+            self.weights.extend(weights);
+        }
+        self.key = Some(key(scene));
+    }
+
+    /// What `preview.radiance` gives for pixel `index`'s sample 0.
+    fn shade(
+        &self,
+        scene: &Scene,
+        solution: Option<&Radiosity>,
+        preview: &Preview,
+        lights: &Geometry,
+        index: usize,
+    ) -> Rgb {
+        let texel = &self.texels[index];
+        let ray = &texel.ray;
+        let mut sampler = first_sampler(scene, index as u64);
+        // The camera's draws, made by the renderer before the integrator's.
+        sampler.next2();
+        sampler.next2();
+        let medium = scene.medium.as_ref();
+        let (surface, t_end) = match lights.intersect(ray, texel.t) {
+            // A light's surface in front of the objects (it reflects nothing).
+            Some(hit) => (surface_radiance(scene, ray, &lights.surface(ray, hit), &mut sampler, medium), hit.t),
+            None => match &texel.hit {
+                Some(s) => {
+                    let mut l = surface_radiance(scene, ray, s, &mut sampler, medium);
+                    if let Some(solution) = solution {
+                        let e = if texel.len > 0 {
+                            let e = solution.indirect_irradiance();
+                            let ws = &self.weights[texel.start as usize..(texel.start + texel.len) as usize];
+                            Some(ws.iter().fold(Rgb::ZERO, |sum, &(i, w)| sum + e[i as usize] * w) * texel.scale)
+                        } else {
+                            None
+                        };
+                        if let Some(e) = e {
+                            l += texel.albedo * e;
+                        }
+                    }
+                    (l, texel.t)
+                }
+                None => (scene.settings.background, scene.settings.max_distance),
+            },
+        };
+        let l = preview.through_medium(scene, ray, surface, t_end, &mut sampler);
+        if l.is_finite() { l } else { Rgb::ZERO }
+    }
+}
+
+/// Sample 0's generator of a pixel, as the renderer makes it.
+fn first_sampler(scene: &Scene, pixel: u64) -> Sampler {
+    Sampler::for_pixel(scene.settings.seed, pixel, 0)
+}
+
+fn key(scene: &Scene) -> Key {
+    let s = &scene.settings;
+    (scene.camera, s.width, s.height, s.seed, s.filter)
+}
+
+/// The surfaces of the scene's area lights where they are now.
+fn light_surfaces(scene: &Scene) -> Geometry {
+    let black = scene.materials.len() as u32 - 1;
+    let mut g = GeometryBuilder::default();
+    for (i, light) in scene.lights.iter().enumerate() {
+        let shape = match *light {
+            Light::Sphere { center, radius, .. } => Shape::sphere(center, radius),
+            Light::Quad { corner, edge_u, edge_v, .. } => Shape::quad(corner, edge_u, edge_v),
+            _ => continue,
+        };
+        g.add(&shape, black, Some(i as u32));
+    }
+    g.build()
+}
+
+/// One term, or the running sum, of the lookup's kernel average, run over
+/// this type instead of over colours to learn the lookup's patches and
+/// weights, whatever its kernel. The lookup computes
+/// (Σᵢ value(i)·wᵢ)·(1/Σ wᵢ): a single `value(i)` times a weight keeps the
+/// weight, adding it to the sum appends (patch, weight) to `sink`, and a
+/// factor on the sum is the final normalisation, kept in `scale`. Small and
+/// `Copy`, so the lookup's by-value arithmetic costs nothing.
+#[derive(Clone, Copy)]
+struct Term<'a> {
+    sink: Option<&'a RefCell<Vec<(u32, f32)>>>,
+    /// A single term's patch and weight (before it joins the sum).
+    single: Option<(u32, f32)>,
+    scale: f32,
+}
+
+impl Default for Term<'_> {
+    /// The empty sum.
+    fn default() -> Self {
+        Term { sink: None, single: None, scale: 1.0 }
+    }
+}
+
+impl std::ops::Mul<f32> for Term<'_> {
+    type Output = Self;
+    fn mul(mut self, f: f32) -> Self {
+        match &mut self.single {
+            Some((_, w)) => *w *= f,
+            None => self.scale *= f,
+        }
+        self
+    }
+}
+
+impl std::ops::Add for Term<'_> {
+    type Output = Self;
+    fn add(self, other: Self) -> Self {
+        let sink = self.sink.or(other.sink);
+        if let (Some(sink), Some(item)) = (sink, other.single) {
+            sink.borrow_mut().push(item);
+        }
+        Term { sink, single: None, scale: self.scale }
+    }
+}
+
+/// Appends the lookup's (patch, weight) pairs at `p` to `out` and returns
+/// the normalisation factor, or None (nothing appended) where no patch is near.
+fn lookup_weights(solution: &Radiosity, p: glam::Vec3, n: glam::Vec3, out: &mut Vec<(u32, f32)>) -> Option<f32> {
+    let sink = RefCell::new(std::mem::take(out));
+    let before = sink.borrow().len();
+    let scale = solution
+        .lookup()
+        .interpolate(solution.patches(), p, n, |i| Term {
+            sink: Some(&sink),
+            single: Some((i as u32, 1.0)),
+            scale: 1.0,
+        })
+        .map(|t| t.scale);
+    *out = sink.into_inner();
+    if scale.is_none() {
+        out.truncate(before);
+    }
+    scale
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::medium::Medium;
+    use crate::preview::set_lights;
+    use crate::render::{RenderObserver, render_samples};
+    use glam::vec3;
+
+    const CORNELL: &str = include_str!("../../../../scenes/cornell_box.toml");
+
+    fn check(scene: &mut Scene) {
+        (scene.settings.width, scene.settings.height) = (48, 27);
+        let mut solution = Radiosity::compile(scene).unwrap();
+        let mut cache = FirstSample::new(scene);
+        let start = scene.lights.clone();
+        for (k, at) in [vec3(2.78, 5.487, 2.795), vec3(1.2, 5.0, 1.5), vec3(4.2, 5.3, 4.0)].into_iter().enumerate() {
+            let moved: Vec<Light> = start.iter().map(|l| l.moved_to(at)).collect();
+            set_lights(scene, &moved);
+            solution.update(scene);
+            let preview = Preview::new(scene, Some(&solution));
+            assert_eq!(cache.is_valid_for(scene), k > 0, "the camera stood still");
+            let cached = cache.render(scene, Some(&solution), &preview);
+            let direct = render_samples(scene, &preview, 0, 1, &RenderObserver::none());
+            assert_eq!(cached, direct, "light at {at}");
+            assert!(cached.mean().max_element() > 0.0);
+        }
+        scene.camera.position.x += 0.1;
+        assert!(!cache.is_valid_for(scene));
+        let preview = Preview::new(scene, Some(&solution));
+        let cached = cache.render(scene, Some(&solution), &preview);
+        assert_eq!(cached, render_samples(scene, &preview, 0, 1, &RenderObserver::none()));
+    }
+
+    #[test]
+    fn the_cached_first_sample_is_the_preview_bit_for_bit_as_the_light_moves() {
+        check(&mut crate::scene::from_toml_str(CORNELL, None).unwrap());
+    }
+
+    #[test]
+    fn in_a_medium_too() {
+        let mut scene = crate::scene::from_toml_str(CORNELL, None).unwrap();
+        scene.medium = Some(Medium::homogeneous(Rgb::splat(0.01), Rgb::splat(0.03), 0.0));
+        check(&mut scene);
+    }
+
+    #[test]
+    fn terms_follow_the_lookups_sum_and_normalisation() {
+        let sink = RefCell::new(Vec::new());
+        let one = |i: u32| Term { sink: Some(&sink), single: Some((i, 1.0)), scale: 1.0 };
+        let sum = (Term::default() + one(3) * 0.5 + one(7) * 0.25) * 4.0;
+        assert_eq!(sum.scale, 4.0);
+        assert_eq!(sink.borrow().as_slice(), &[(3, 0.5), (7, 0.25)]);
+    }
+}
