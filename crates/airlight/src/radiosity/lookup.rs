@@ -65,12 +65,30 @@ impl Lookup {
         let r = self.radius;
         let lo = ((p - r) / r).floor().as_ivec3();
         let hi = ((p + r) / r).floor().as_ivec3();
+        // Cells that hold no centre the loop below could take are passed
+        // over before their hash lookup: those wholly beyond the tangent slab
+        // |n·(c − p)| ≤ R/2 (on a wall, one layer of the three across it) or
+        // wholly beyond R. A margin keeps centres binned across a cell's edge
+        // by rounding; the result is the same as testing every cell.
+        let margin = 1e-3 * r;
+        let slab = 0.5 * r + margin;
+        let half_thickness = 0.5 * r * n.abs().element_sum();
         let mut total = T::default();
         let mut weight = 0.0;
         for x in lo.x..=hi.x {
             for y in lo.y..=hi.y {
                 for z in lo.z..=hi.z {
-                    let Some(&(a, b)) = self.cells.get(&IVec3::new(x, y, z)) else {
+                    let cell = IVec3::new(x, y, z);
+                    let cell_lo = cell.as_vec3() * r;
+                    let off_plane = n.dot(cell_lo + 0.5 * r - p);
+                    if off_plane.abs() - half_thickness > slab {
+                        continue;
+                    }
+                    let nearest = p.clamp(cell_lo, cell_lo + r);
+                    if nearest.distance(p) >= r + margin {
+                        continue;
+                    }
+                    let Some(&(a, b)) = self.cells.get(&cell) else {
                         continue;
                     };
                     for &i in &self.ids[a as usize..b as usize] {
@@ -114,5 +132,62 @@ impl Hasher for CellHasher {
     }
     fn write_u64(&mut self, v: u64) {
         self.0 = (self.0.rotate_left(5) ^ v).wrapping_mul(0x51_7c_c1_b7_27_22_0a_95);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::radiosity::patches::PatchShape;
+    use crate::sampling::{Sampler, uniform_sphere};
+
+    /// The kernel average over every patch, without the grid.
+    fn brute_force(patches: &[Patch], r: f32, p: Vec3, n: Vec3) -> Option<f32> {
+        let (mut total, mut weight) = (0.0, 0.0);
+        for (i, patch) in patches.iter().enumerate() {
+            let d = patch.center - p;
+            let facing = 2.0 * n.dot(patch.normal) - 1.0;
+            if facing <= 0.0 || n.dot(d).abs() > 0.5 * r || d.length() >= r {
+                continue;
+            }
+            let w = (1.0 - d.length() / r) * facing;
+            total += i as f32 * w;
+            weight += w;
+        }
+        (weight > 0.0).then(|| total / weight)
+    }
+
+    #[test]
+    fn the_grid_takes_every_patch_that_testing_all_of_them_takes() {
+        // Patches on axis-aligned and slanted planes through a box, queried
+        // at random points near them with their normals: the grid, which
+        // skips cells, must give what testing every patch gives.
+        let mut s = Sampler::for_pixel(11, 0, 0);
+        let r = 0.3;
+        let normals = [Vec3::X, Vec3::Y, -Vec3::Z, Vec3::new(1.0, 2.0, -0.5).normalize()];
+        let mut patches = Vec::new();
+        for (k, &n) in normals.iter().enumerate() {
+            let (t, b) = crate::sampling::basis(n);
+            for _ in 0..400 {
+                let center = n * (0.4 * k as f32) + (t * (s.next() - 0.5) + b * (s.next() - 0.5)) * 3.0;
+                let shape = PatchShape { origin: center, e1: t * 0.1, e2: b * 0.1, triangle: false };
+                patches.push(Patch { center, normal: n, area: 0.01, radius: 0.07, material: 0, object: 0, shape });
+            }
+        }
+        let lookup = Lookup::build(&patches, r);
+        let mut compared = 0;
+        for _ in 0..4000 {
+            let source = &patches[(s.next() * patches.len() as f32) as usize % patches.len()];
+            let n = if s.next() < 0.8 { source.normal } else { uniform_sphere(s.next2()) };
+            let p = source.center + uniform_sphere(s.next2()) * (0.4 * r * s.next());
+            let grid = lookup.interpolate(&patches, p, n, |i| i as f32);
+            let all = brute_force(&patches, r, p, n);
+            match (grid, all) {
+                (Some(a), Some(b)) => assert!((a - b).abs() <= 1e-4 * b.abs().max(1.0), "{a} vs {b} at {p}"),
+                (a, b) => assert_eq!(a.is_some(), b.is_some(), "at {p}: {a:?} vs {b:?}"),
+            }
+            compared += grid.is_some() as u32;
+        }
+        assert!(compared > 3000, "{compared}");
     }
 }
