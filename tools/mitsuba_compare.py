@@ -14,7 +14,7 @@ Mitsuba's `volpath` (or `path` in vacuum), renders it with `airlight render
 against itself with another seed, from which each image's own error and
 the time each renderer needs for the same error follow (error ∝ 1/√time).
 
-Conventions matched (../shared/DESIGN.md): intensities in W/sr, radiance for
+Conventions matched (docs/scene-format.md): intensities in W/sr, radiance for
 area lights; a pixel is the box-filtered mean; Mitsuba's max_depth counts
 path segments, so it is Airlight's max_depth + 1; a quad light is a
 `rectangle` whose +z normal is edge_u × edge_v; an area light's surface

@@ -1,9 +1,9 @@
 //! `airlight`: render scenes, check them, compare images.
 
+use airlight::SceneFile;
 use airlight::film::{self, Image};
 use airlight::integrator::IntegratorKind;
-use airlight::render::{RenderObserver, render_with};
-use airlight::scene::{self, Scene};
+use airlight::render::RenderObserver;
 use clap::{Parser, Subcommand};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -119,34 +119,30 @@ fn main() -> ExitCode {
     }
 }
 
-/// The scene at `path`, or the built-in demo scene.
-fn load(path: Option<&Path>) -> Result<Scene, String> {
+/// The scene file at `path`, or the built-in demo scene.
+fn load(path: Option<&Path>) -> Result<SceneFile, String> {
     match path {
-        Some(path) => scene::load(path).map_err(|e| e.to_string()),
-        None => scene::from_toml_str(DEMO_SCENE, None).map_err(|e| format!("built-in demo scene: {e}")),
+        Some(path) => SceneFile::load(path).map_err(|e| e.to_string()),
+        None => SceneFile::from_toml_str(DEMO_SCENE, None).map_err(|e| format!("built-in demo scene: {e}")),
     }
 }
 
 fn gi(args: GiArgs) -> Result<(), String> {
-    use airlight::integrator::RadiosityIntegrator;
-    use airlight::radiosity::{CompileParams, Radiosity};
-    let mut scene = load(Some(&args.scene))?;
-    let s = &mut scene.settings;
+    use airlight::integrator::{Integrator, RadiosityIntegrator};
+    use airlight::render::{frame_time, render, set_time};
+    let SceneFile { mut scene, integrator: mut desc } = load(Some(&args.scene))?;
+    let options = &mut desc.radiosity;
     if let Some(v) = args.patch_size {
-        if !(v.is_finite() && v > 0.0) {
-            return Err(format!("--patch-size must be a positive number, got {v}"));
-        }
-        s.patch_size = Some(v);
+        options.patch_size = Some(v);
     }
     if let Some(v) = args.link_threshold {
-        if !(v.is_finite() && v >= 0.0) {
-            return Err(format!("--link-threshold must be a number ≥ 0, got {v}"));
-        }
-        s.link_threshold = v;
+        options.link_threshold = v;
     }
     if let Some(v) = args.bounces {
-        s.bounces = v;
+        options.bounces = v;
     }
+    desc.validate().map_err(|e| format!("--{}", e.to_string().replace('_', "-")))?;
+    let s = scene.settings_mut();
     if let Some(v) = args.spp {
         s.spp = v;
     }
@@ -156,6 +152,7 @@ fn gi(args: GiArgs) -> Result<(), String> {
     if let Some(v) = args.height {
         s.height = v;
     }
+    s.validate()?;
     if let Some(dir) = &args.output_dir {
         std::fs::create_dir_all(dir).map_err(|e| format!("cannot create `{}`: {e}", dir.display()))?;
     }
@@ -164,9 +161,10 @@ fn gi(args: GiArgs) -> Result<(), String> {
         .build()
         .map_err(|e| format!("cannot start worker threads: {e}"))?;
     pool.install(|| {
-        let params = CompileParams::for_scene(&scene);
-        let solution = Radiosity::compile_with(&scene, params).map_err(|e| format!("{}: {e}", args.scene.display()))?;
-        let st = solution.stats();
+        let mut integrator = RadiosityIntegrator::new(&scene, desc.radiosity, desc.raymarch)
+            .map_err(|e| format!("{}: {e}", args.scene.display()))?;
+        let solution = &integrator.solution;
+        let (params, st) = (solution.params(), solution.stats());
         let ms = |d: std::time::Duration| d.as_secs_f64() * 1e3;
         println!("scene: {}", args.scene.display());
         println!(
@@ -174,7 +172,7 @@ fn gi(args: GiArgs) -> Result<(), String> {
             rayon::current_num_threads(),
             params.patch_size,
             params.link_threshold,
-            scene.settings.bounces
+            desc.radiosity.bounces
         );
         println!("patches: {} ({} sides that see nothing dropped), clusters: {}", st.patches, st.dropped, st.clusters);
         println!(
@@ -193,21 +191,16 @@ fn gi(args: GiArgs) -> Result<(), String> {
             ms(st.cluster),
             ms(st.link)
         );
-        let mut integrator =
-            RadiosityIntegrator { solution, steps: scene.settings.steps, jitter: scene.settings.jitter };
-        let bounces = scene.settings.bounces;
         let mut frames = Vec::with_capacity(args.frames as usize);
         for k in 0..args.frames {
-            let time = if args.frames > 1 { k as f32 / (args.frames - 1) as f32 } else { 0.0 };
-            let lights = scene.lights_at(time);
-            let times = integrator.solution.update_with(&scene, &lights, bounces);
-            frames.push(times);
+            set_time(&mut scene, &mut integrator, frame_time(k, args.frames)).map_err(|e| e.to_string())?;
+            frames.push(integrator.last_update);
             if let Some(dir) = &args.output_dir {
-                scene.lights = lights;
-                let image = render_with(&scene, &integrator, &RenderObserver::none());
+                let image = render(&scene, &integrator as &dyn Integrator, &RenderObserver::none());
                 let out = dir.join(format!("frame_{k:04}.png"));
+                let s = scene.settings();
                 image
-                    .write(&out, scene.settings.exposure, scene.settings.tonemap)
+                    .save_with(&out, s.exposure, s.tonemap)
                     .map_err(|e| format!("cannot write `{}`: {e}", out.display()))?;
             }
         }
@@ -231,34 +224,32 @@ fn gi(args: GiArgs) -> Result<(), String> {
 }
 
 fn info(path: &Path) -> Result<(), String> {
-    let scene = load(Some(path))?;
-    let s = &scene.settings;
+    let SceneFile { scene, integrator } = load(Some(path))?;
+    let s = scene.settings();
     println!("scene: {}", path.display());
-    println!("image: {}×{}, {} spp, integrator {}", s.width, s.height, s.spp, s.integrator);
-    if s.integrator == IntegratorKind::Stochastic {
-        println!("sampling: {}, {}", s.sampling, if s.stratify { "stratified" } else { "independent" });
+    println!("image: {}×{}, {} spp, integrator {}", s.width, s.height, s.spp, integrator.kind);
+    if integrator.kind == IntegratorKind::Stochastic {
+        let o = integrator.stochastic;
+        println!("sampling: {}, {}", o.sampling, if o.stratify { "stratified" } else { "independent" });
     }
-    println!(
-        "camera: {:?} at {} looking along {}",
-        scene.camera.projection, scene.camera.position, scene.camera.forward
-    );
-    let (prims, planes) = scene.geometry.primitive_count();
+    let camera = scene.camera();
+    println!("camera: {:?} at {} looking along {}", camera.projection, camera.position, camera.forward);
+    let (prims, planes) = scene.geometry().primitive_count();
     println!("geometry: {prims} bounded primitives, {planes} planes");
-    println!("materials: {}", scene.materials.len() - 1);
-    println!("lights: {}", scene.lights.len());
-    for (light, path) in scene.lights.iter().zip(&scene.light_paths) {
+    println!("materials: {}", scene.materials().len());
+    println!("lights: {}", scene.lights().len());
+    for (light, path) in scene.lights().iter().zip(scene.light_paths()) {
         println!("  {light:?}");
         if let Some(path) = path {
             println!("    moves along {} keyframes", path.keys().len());
         }
     }
-    match &scene.medium {
+    match scene.medium() {
         Some(m) => println!("medium: {m:?}"),
         None => println!("medium: none (vacuum)"),
     }
     Ok(())
 }
-
 fn compare(a: &Path, b: &Path, map: Option<&Path>) -> Result<(), String> {
     let image = Image::read_exr(a).map_err(|e| format!("cannot read `{}`: {e}", a.display()))?;
     let reference = Image::read_exr(b).map_err(|e| format!("cannot read `{}`: {e}", b.display()))?;
@@ -278,7 +269,7 @@ fn compare(a: &Path, b: &Path, map: Option<&Path>) -> Result<(), String> {
     println!("mean_b: {} {} {}", mb.x, mb.y, mb.z);
     if let Some(map) = map {
         film::error_map(&image, &reference, e.max as f32)
-            .write(map, 0.0, scene::Tonemap::Clamp)
+            .save(map)
             .map_err(|e| format!("cannot write `{}`: {e}", map.display()))?;
     }
     Ok(())
@@ -330,8 +321,6 @@ fn attenuation(args: AttenuationArgs) -> Result<(), String> {
         log_y: true,
         series,
     };
-    plot.render()
-        .write(&args.output, 0.0, scene::Tonemap::Clamp)
-        .map_err(|e| format!("cannot write `{}`: {e}", args.output.display()))?;
+    plot.render().save(&args.output).map_err(|e| format!("cannot write `{}`: {e}", args.output.display()))?;
     Ok(())
 }

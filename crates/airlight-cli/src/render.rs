@@ -2,11 +2,12 @@
 //! error target), or the numbered frames of a light animation.
 
 use crate::load;
+use airlight::SceneFile;
 use airlight::film::Image;
 use airlight::integrator::analytic::LightQuadrature;
-use airlight::integrator::{self, IntegratorKind, Sampling};
-use airlight::render::{Progressive, RenderObserver, render_with};
-use airlight::scene::{LightCulling, Scene};
+use airlight::integrator::{Integrator, IntegratorKind, Sampling};
+use airlight::render::{Progressive, RenderObserver, frame_time, set_time};
+use airlight::scene::Scene;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -89,14 +90,14 @@ struct FrameOutputs {
 }
 
 pub fn render(args: RenderArgs) -> Result<(), String> {
-    let scene = configure(&args)?;
+    let SceneFile { mut scene, integrator: desc } = configure(&args)?;
     let outputs = output_paths(&args)?;
     if let Some(v) = &args.variance
         && !v.extension().is_some_and(|e| e.eq_ignore_ascii_case("exr"))
     {
         return Err(format!("cannot write `{}`: the variance is written as .exr", v.display()));
     }
-    if args.variance.is_some() && scene.settings.spp < 2 {
+    if args.variance.is_some() && scene.settings().spp < 2 {
         return Err("--variance: a variance needs at least 2 samples per pixel (--spp)".into());
     }
     if args.frames.is_some() && !scene.is_animated() {
@@ -108,9 +109,8 @@ pub fn render(args: RenderArgs) -> Result<(), String> {
         .map_err(|e| format!("cannot start worker threads: {e}"))?;
     let progressive = args.progressive || args.target_error.is_some() || args.variance.is_some();
     let frames = args.frames.unwrap_or(1);
-    let s = &scene.settings;
-    let pixels = s.width as u64 * s.height as u64;
-    let per_frame = if progressive { pixels * s.spp as u64 } else { pixels };
+    let s = scene.settings();
+    let per_frame = s.width as u64 * s.height as u64 * s.spp as u64;
     let bar = if args.quiet {
         ProgressBar::hidden()
     } else {
@@ -120,14 +120,15 @@ pub fn render(args: RenderArgs) -> Result<(), String> {
         bar.set_style(style.progress_chars("=> "));
     }
     let start = Instant::now();
-    let mut scene = scene;
+    // Built once: between frames the integrator only hears that the lights
+    // moved (radiosity relights without recompiling).
+    let mut integrator = pool.install(|| desc.build(&scene)).map_err(|e| e.to_string())?;
     let mut written = Vec::new();
     for frame in 0..frames {
         let outputs = match args.frames {
             Some(_) => {
-                let time = if frames > 1 { frame as f32 / (frames - 1) as f32 } else { 0.0 };
-                scene.lights = scene.lights_at(time);
-                scene.light_culling = LightCulling::new(&scene.lights);
+                pool.install(|| set_time(&mut scene, integrator.as_mut(), frame_time(frame, frames)))
+                    .map_err(|e| e.to_string())?;
                 FrameOutputs {
                     images: outputs.iter().map(|p| numbered(p, frame)).collect(),
                     variance: args.variance.as_deref().map(|p| numbered(p, frame)),
@@ -136,10 +137,11 @@ pub fn render(args: RenderArgs) -> Result<(), String> {
             None => FrameOutputs { images: outputs.clone(), variance: args.variance.clone() },
         };
         let frame_label = args.frames.map(|n| format!(" frame {}/{n}", frame + 1)).unwrap_or_default();
+        let label = format!("{}{frame_label}", desc.kind);
         let summary = if progressive {
-            render_progressive(&scene, &pool, &bar, &outputs, args.target_error, &frame_label)?
+            render_progressive(&scene, integrator.as_ref(), &pool, &bar, &outputs, args.target_error, &label)?
         } else {
-            render_once(&scene, &pool, &bar, &outputs, &frame_label)?
+            render_once(&scene, integrator.as_ref(), &pool, &bar, &outputs, &label)?
         };
         if !args.quiet && args.frames.is_none() && !summary.is_empty() {
             bar.suspend(|| eprintln!("{summary}"));
@@ -150,7 +152,7 @@ pub fn render(args: RenderArgs) -> Result<(), String> {
     let elapsed = start.elapsed();
     bar.finish_and_clear();
     if !args.quiet {
-        let s = &scene.settings;
+        let s = scene.settings();
         let what = match args.frames {
             Some(n) => format!("{n} frames of {}×{}", s.width, s.height),
             None => format!("{}×{}", s.width, s.height),
@@ -165,18 +167,12 @@ pub fn render(args: RenderArgs) -> Result<(), String> {
     Ok(())
 }
 
-/// The scene with the command line's overrides applied.
-fn configure(args: &RenderArgs) -> Result<Scene, String> {
-    let mut scene = load(args.scene.as_deref())?;
-    let s = &mut scene.settings;
-    if let Some(v) = args.integrator {
-        s.integrator = v;
-    }
+/// The scene file with the command line's overrides applied and checked.
+fn configure(args: &RenderArgs) -> Result<SceneFile, String> {
+    let mut file = load(args.scene.as_deref())?;
+    let s = file.scene.settings_mut();
     if let Some(v) = args.spp {
         s.spp = v;
-    }
-    if let Some(v) = args.steps {
-        s.steps = v;
     }
     if let Some(v) = args.width {
         s.width = v;
@@ -187,31 +183,34 @@ fn configure(args: &RenderArgs) -> Result<Scene, String> {
     if let Some(v) = args.seed {
         s.seed = v;
     }
+    s.validate()?;
+    let d = &mut file.integrator;
+    if let Some(v) = args.integrator {
+        d.kind = v;
+    }
+    if let Some(v) = args.steps {
+        d.raymarch.steps = v;
+    }
     if let Some(v) = args.sampling {
-        s.sampling = v;
+        d.stochastic.sampling = v;
     }
     if args.no_stratify {
-        s.stratify = false;
-    }
-    if let Some(model) = args.attenuation {
-        for light in &mut scene.lights {
-            if let Some(a) = light.attenuation() {
-                let a = a.with_model(model).map_err(|e| format!("--attenuation: {e}"))?;
-                *light = light.with_attenuation(a);
-            }
-        }
-        scene.light_culling = LightCulling::new(&scene.lights);
+        d.stochastic.stratify = false;
     }
     if args.shadows {
-        s.shadows = true;
+        d.analytic.shadows = true;
     }
     if let Some(v) = args.light_steps {
-        s.light_steps = v;
+        d.analytic.light_steps = v;
     }
     if let Some(v) = args.light_quadrature {
-        s.light_quadrature = v;
+        d.analytic.quadrature = v;
     }
-    Ok(scene)
+    d.validate().map_err(|e| format!("--{}", e.to_string().replace('_', "-")))?;
+    if let Some(model) = args.attenuation {
+        file.scene.set_attenuation_model(model).map_err(|e| format!("--attenuation: {e}"))?;
+    }
+    Ok(file)
 }
 
 /// The image outputs: as given, or NAME.png after the scene file.
@@ -246,9 +245,9 @@ fn numbered(path: &Path, frame: u32) -> PathBuf {
 }
 
 fn write_images(scene: &Scene, image: &Image, outputs: &[PathBuf]) -> Result<(), String> {
-    let s = &scene.settings;
+    let s = scene.settings();
     for out in outputs {
-        image.write(out, s.exposure, s.tonemap).map_err(|e| format!("cannot write `{}`: {e}", out.display()))?;
+        image.save_with(out, s.exposure, s.tonemap).map_err(|e| format!("cannot write `{}`: {e}", out.display()))?;
     }
     Ok(())
 }
@@ -256,17 +255,17 @@ fn write_images(scene: &Scene, image: &Image, outputs: &[PathBuf]) -> Result<(),
 /// All samples in one go; returns nothing to report.
 fn render_once(
     scene: &Scene,
+    integrator: &dyn Integrator,
     pool: &rayon::ThreadPool,
     bar: &ProgressBar,
     outputs: &FrameOutputs,
-    frame_label: &str,
+    label: &str,
 ) -> Result<String, String> {
-    let integrator = integrator::for_scene(scene)?;
-    let s = &scene.settings;
-    bar.set_message(format!("{} {}×{} {} spp{frame_label}", s.integrator, s.width, s.height, s.spp));
+    let s = scene.settings();
+    bar.set_message(format!("{label} {}×{} {} spp", s.width, s.height, s.spp));
     let progress = |n: u64| bar.inc(n);
     let observer = RenderObserver { progress: Some(&progress), cancel: None };
-    let image = pool.install(|| render_with(scene, integrator.as_ref(), &observer));
+    let image = pool.install(|| airlight::render(scene, integrator, &observer));
     write_images(scene, &image, &outputs.images)?;
     Ok(String::new())
 }
@@ -276,25 +275,23 @@ fn render_once(
 /// error target; returns the samples reached and the estimated error.
 fn render_progressive(
     scene: &Scene,
+    integrator: &dyn Integrator,
     pool: &rayon::ThreadPool,
     bar: &ProgressBar,
     outputs: &FrameOutputs,
     target_error: Option<f64>,
-    frame_label: &str,
+    label: &str,
 ) -> Result<String, String> {
-    let integrator = integrator::for_scene(scene)?;
-    let s = &scene.settings;
+    let s = scene.settings();
     let mut progressive = Progressive::new(scene);
     let mut error = f64::INFINITY;
     while !progressive.finished() && !target_error.is_some_and(|target| error < target) {
-        let count = progressive.next_pass_size() as u64;
-        let progress = |n: u64| bar.inc(n * count);
+        let progress = |n: u64| bar.inc(n);
         let observer = RenderObserver { progress: Some(&progress), cancel: None };
-        pool.install(|| progressive.pass(scene, integrator.as_ref(), &observer));
+        pool.install(|| progressive.pass(scene, integrator, &observer));
         error = progressive.estimated_relative_error();
         bar.set_message(format!(
-            "{} {}×{} {}/{} spp, est. error {}{frame_label}",
-            s.integrator,
+            "{label} {}×{} {}/{} spp, est. error {}",
             s.width,
             s.height,
             progressive.samples(),
@@ -305,10 +302,7 @@ fn render_progressive(
         // The variance is known from the second sample on (EXR: linear, the
         // tone map is not applied).
         if let Some(path) = outputs.variance.as_ref().filter(|_| progressive.samples() >= 2) {
-            progressive
-                .variance()
-                .write(path, 1.0, s.tonemap)
-                .map_err(|e| format!("cannot write `{}`: {e}", path.display()))?;
+            progressive.variance().save(path).map_err(|e| format!("cannot write `{}`: {e}", path.display()))?;
         }
     }
     // Samples skipped by reaching the target still count toward the bar.
@@ -316,7 +310,6 @@ fn render_progressive(
     bar.inc(skipped);
     Ok(format!("{} spp, estimated relative error {}", progressive.samples(), format_error(error)))
 }
-
 fn format_error(error: f64) -> String {
     if error.is_finite() { format!("{error:.4}") } else { "unknown (fewer than 2 samples)".into() }
 }
@@ -329,11 +322,7 @@ fn parse_target_error(s: &str) -> Result<f64, String> {
 }
 
 fn parse_light_quadrature(s: &str) -> Result<LightQuadrature, String> {
-    match s {
-        "gauss" => Ok(LightQuadrature::Gauss),
-        "uniform" => Ok(LightQuadrature::Uniform),
-        _ => Err(format!("unknown light quadrature `{s}`; expected gauss or uniform")),
-    }
+    s.parse()
 }
 
 fn parse_attenuation(s: &str) -> Result<airlight::light::AttenuationModel, String> {

@@ -100,8 +100,8 @@ const SIZE: (u32, u32) = (96, 54);
 fn classify(scene: &airlight::Scene, class: impl Fn(Option<Vec3>) -> u8) -> Vec<Option<u8>> {
     let (w, h) = SIZE;
     let at = |film: Vec2| {
-        let ray: Ray = scene.camera.ray(film, w, h, Vec2::ZERO);
-        class(scene.geometry.intersect(&ray, 100.0).map(|hit| ray.origin + ray.dir * hit.t))
+        let ray: Ray = scene.camera().ray(film, w, h, Vec2::ZERO);
+        class(scene.geometry().intersect(&ray, 100.0).map(|hit| ray.origin + ray.dir * hit.t))
     };
     let mut out = Vec::new();
     for y in 0..h {
@@ -133,8 +133,8 @@ fn a_light_moved_toward_a_wall_brightens_it_and_leaves_the_other_room_unchanged(
     let last = Image::read_exr(&dir.path().join("frames/frame_0002.exr")).unwrap();
     assert_eq!((first.width, first.height), SIZE);
 
-    let mut scene = airlight::scene::from_toml_str(TWO_ROOMS, None).unwrap();
-    (scene.settings.width, scene.settings.height) = SIZE;
+    let mut scene = airlight::SceneFile::from_toml_str(TWO_ROOMS, None).unwrap().scene;
+    (scene.settings_mut().width, scene.settings_mut().height) = SIZE;
     // 0: the wall the light nears; 1: the other room, but for a strip along
     // the dividing wall as wide as the radiosity lookup's kernel (1.5 patch
     // sizes): shading there averages patches from both sides of the wall,

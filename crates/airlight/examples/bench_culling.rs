@@ -6,7 +6,7 @@
 use airlight::integrator::Direct;
 use airlight::light::{Attenuation, AttenuationModel};
 use airlight::prelude::*;
-use airlight::render::render_with;
+use airlight::render::render;
 use airlight::sampling::Sampler;
 use std::time::Instant;
 
@@ -37,13 +37,13 @@ fn main() {
     let (culled, full) = (scene(true), scene(false));
     let mut reach = 0;
     culled.for_each_light_at(Vec3::ZERO, |_, _| reach += 1);
-    println!("1000 point lights, range {:.2}; {reach} reach the origin", culled.lights[0].reach().unwrap().1);
+    println!("1000 point lights, range {:.2}; {reach} reach the origin", culled.lights()[0].reach().unwrap().1);
     for round in 0..2 {
         let t = Instant::now();
-        let a = render_with(&culled, &Direct, &RenderObserver::none());
+        let a = render(&culled, &Direct, &RenderObserver::none());
         let with = t.elapsed().as_secs_f64();
         let t = Instant::now();
-        let b = render_with(&full, &Direct, &RenderObserver::none());
+        let b = render(&full, &Direct, &RenderObserver::none());
         let without = t.elapsed().as_secs_f64();
         assert!(a == b, "culling changed the image");
         println!("round {round}: with culling {with:.3} s, without {without:.3} s: {:.1}× faster", without / with);

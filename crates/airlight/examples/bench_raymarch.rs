@@ -12,30 +12,31 @@
 use airlight::film::compare;
 use airlight::geometry::shadow_rays_traced;
 use airlight::integrator::Raymarch;
-use airlight::render::{RenderObserver, render_with};
+use airlight::integrator::RaymarchOptions;
+use airlight::render::{RenderObserver, render};
 use std::time::Instant;
 
 fn main() {
     let path = std::env::args().nth(1).unwrap_or_else(|| "scenes/spheres_spot_fog.toml".into());
-    let mut scene = airlight::scene::load(path.as_ref()).unwrap_or_else(|e| panic!("{e}"));
-    (scene.settings.width, scene.settings.height, scene.settings.spp) = (640, 480, 1);
+    let mut scene = airlight::SceneFile::load(path.as_ref()).unwrap_or_else(|e| panic!("{e}")).scene;
+    (scene.settings_mut().width, scene.settings_mut().height, scene.settings_mut().spp) = (640, 480, 1);
     let one = rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap();
     let traced = || one.broadcast(|_| shadow_rays_traced()).iter().sum::<u64>();
     println!("{path}, 640×480, 1 spp, one thread");
     println!("| steps | seconds | shadow rays | M shadow rays/s |");
     println!("|---|---|---|---|");
     for steps in [50, 100, 300] {
-        let integrator = Raymarch { steps, jitter: true };
+        let integrator = Raymarch::new(RaymarchOptions { steps, jitter: true });
         let before = traced();
         let t = Instant::now();
-        one.install(|| render_with(&scene, &integrator, &RenderObserver::none()));
+        one.install(|| render(&scene, &integrator, &RenderObserver::none()));
         let secs = t.elapsed().as_secs_f64();
         let rays = traced() - before;
         println!("| {steps} | {secs:.2} | {rays} | {:.1} |", rays as f64 / secs / 1e6);
     }
 
     // Shadow rays alone: from random points in the lit volume to the light.
-    let light = match scene.lights[0] {
+    let light = match scene.lights()[0] {
         airlight::light::Light::Spot { position, .. } | airlight::light::Light::Point { position, .. } => position,
         _ => glam::Vec3::new(0.0, 6.0, 0.0),
     };
@@ -48,7 +49,7 @@ fn main() {
         })
         .collect();
     let t = Instant::now();
-    let blocked = rays.iter().filter(|(p, d, tmax)| scene.geometry.occluded(*p, *d, *tmax)).count();
+    let blocked = rays.iter().filter(|(p, d, tmax)| scene.geometry().occluded(*p, *d, *tmax)).count();
     let secs = t.elapsed().as_secs_f64();
     println!(
         "\nshadow rays alone: {} in {secs:.3} s on one thread, {:.1}% blocked: {:.1} M shadow rays/s",
@@ -57,8 +58,9 @@ fn main() {
         rays.len() as f64 / secs / 1e6
     );
 
-    (scene.settings.width, scene.settings.height) = (320, 240);
-    let render = |steps, jitter| render_with(&scene, &Raymarch { steps, jitter }, &RenderObserver::none());
+    (scene.settings_mut().width, scene.settings_mut().height) = (320, 240);
+    let render =
+        |steps, jitter| render(&scene, &Raymarch::new(RaymarchOptions { steps, jitter }), &RenderObserver::none());
     let reference = render(4096, false);
     println!("\nrelative RMSE against 4096 steps, 320×240, 1 spp");
     println!("| steps | jitter off | jitter on |");

@@ -14,9 +14,10 @@
 //! equiangular with stratification reaches uniform's 64-spp error at 8 spp
 //! or fewer.
 
+use airlight::SceneFile;
 use airlight::film::{Image, compare};
-use airlight::integrator::{Integrator, Raymarch, Sampling, Stochastic};
-use airlight::render::{RenderObserver, render_with};
+use airlight::integrator::{Integrator, IntegratorDesc, Raymarch, RaymarchOptions, Sampling, Stochastic};
+use airlight::render::RenderObserver;
 use airlight::scene::Scene;
 use std::time::Instant;
 
@@ -24,16 +25,16 @@ const SPPS: [u32; 6] = [1, 2, 4, 8, 16, 64];
 
 /// The scene at `path`, at the benchmark's size, spp and seed. (Scenes hold
 /// a BVH and are not Clone; loading is cheap next to rendering.)
-fn load(path: &str, (width, height): (u32, u32), spp: u32, seed: u64) -> Scene {
-    let mut scene = airlight::scene::load(path.as_ref()).unwrap_or_else(|e| panic!("{e}"));
-    let s = &mut scene.settings;
+fn load(path: &str, (width, height): (u32, u32), spp: u32, seed: u64) -> (Scene, IntegratorDesc) {
+    let SceneFile { mut scene, integrator } = SceneFile::load(path.as_ref()).unwrap_or_else(|e| panic!("{e}"));
+    let s = scene.settings_mut();
     (s.width, s.height, s.spp, s.seed) = (width, height, spp, seed);
-    scene
+    (scene, integrator)
 }
 
 fn render(scene: &Scene, integrator: &dyn Integrator) -> (Image, f64) {
     let t = Instant::now();
-    let image = render_with(scene, integrator, &RenderObserver::none());
+    let image = airlight::render(scene, integrator, &RenderObserver::none());
     (image, t.elapsed().as_secs_f64())
 }
 
@@ -53,16 +54,16 @@ fn main() {
     for path in ["scenes/glow.toml", "scenes/sdf_isometric.toml"] {
         let size = (w, h);
         let equiangular = Stochastic { sampling: Sampling::Equiangular, stratify: true };
-        let (reference, ref_secs) = render(&load(path, size, ref_spp, 1_000_003), &equiangular);
+        let (reference, ref_secs) = render(&load(path, size, ref_spp, 1_000_003).0, &equiangular);
         // An independent check of the reference: the closed form where it
         // is exact (point lights, no shadows: the glow), else the march.
         let (check_name, check) = if path.contains("glow") {
-            let scene = load(path, size, 64, 7);
-            let analytic = airlight::integrator::for_scene(&scene).expect("glow.toml names analytic");
+            let (scene, desc) = load(path, size, 64, 7);
+            let analytic = desc.build(&scene).expect("glow.toml names analytic");
             ("analytic (closed form, 64 spp)", render(&scene, analytic.as_ref()).0)
         } else {
-            let march = Raymarch { steps: 256, jitter: true };
-            ("raymarch (256 steps, 16 spp, jittered)", render(&load(path, size, 16, 7), &march).0)
+            let march = Raymarch::new(RaymarchOptions { steps: 256, jitter: true });
+            ("raymarch (256 steps, 16 spp, jittered)", render(&load(path, size, 16, 7).0, &march).0)
         };
         println!("\n## {path}, {w}×{h}\n");
         println!(
@@ -81,7 +82,7 @@ fn main() {
             let mut errors = Vec::new();
             let mut per_spp = 0.0;
             for spp in SPPS {
-                let (image, secs) = render(&load(path, size, spp, 42), &integrator);
+                let (image, secs) = render(&load(path, size, spp, 42).0, &integrator);
                 errors.push(compare(&image, &reference).unwrap().rel_rmse);
                 if spp == 64 {
                     per_spp = secs / 64.0;

@@ -1,6 +1,6 @@
 //! Cameras: perspective with an optional thin lens, and orthographic with an
 //! isometric preset. Right-handed world, y up; the image's right is
-//! normalize(forward × up) and pixel (0, 0) is the top-left (DESIGN.md).
+//! normalize(forward × up) and pixel (0, 0) is the top-left (docs/scene-format.md).
 
 use crate::geometry::Ray;
 use crate::sampling::concentric_disk;

@@ -15,9 +15,18 @@
 //!     .light(Light::point(vec3(0.0, 4.0, -2.0), Rgb::splat(20.0)))
 //!     .build()
 //!     .unwrap();
-//! let image = airlight::render(&scene, &RenderObserver::none());
+//! let integrator = IntegratorDesc::new(IntegratorKind::Direct).build(&scene).unwrap();
+//! let image = airlight::render(&scene, integrator.as_ref(), &RenderObserver::none());
 //! assert!(image.pixel(16, 12).x > 0.0);
+//! # let dir = std::env::temp_dir().join(format!("airlight-doc-{}", std::process::id()));
+//! # std::fs::create_dir_all(&dir).unwrap();
+//! image.save(dir.join("sphere.png")).unwrap();
+//! # std::fs::remove_dir_all(&dir).unwrap();
 //! ```
+//!
+//! A scene file gives a scene and the integrator it asks for:
+//! [`SceneFile::load`]. The file format, units and conventions are in
+//! docs/scene-format.md.
 
 pub mod camera;
 pub mod film;
@@ -31,6 +40,7 @@ pub mod radiosity;
 pub mod render;
 pub mod sampling;
 pub mod scene;
+mod scene_file;
 
 /// Linear RGB radiance, irradiance or reflectance.
 pub type Rgb = glam::Vec3;
@@ -39,6 +49,7 @@ pub use camera::Camera;
 pub use film::Image;
 pub use render::{RenderObserver, render};
 pub use scene::{Scene, SceneBuilder};
+pub use scene_file::SceneFile;
 
 /// The names most programs need.
 pub mod prelude {
@@ -46,11 +57,12 @@ pub mod prelude {
     pub use crate::camera::Camera;
     pub use crate::film::Image;
     pub use crate::geometry::Shape;
-    pub use crate::integrator::IntegratorKind;
+    pub use crate::integrator::{IntegratorDesc, IntegratorKind};
     pub use crate::light::Light;
     pub use crate::material::Material;
     pub use crate::medium::Medium;
     pub use crate::render::{RenderObserver, render};
     pub use crate::scene::{Scene, SceneBuilder};
+    pub use crate::scene_file::SceneFile;
     pub use glam::{Vec3, vec3};
 }

@@ -1,4 +1,4 @@
-//! Surface materials. All reflect on both sides (DESIGN.md: two-sided).
+//! Surface materials. All reflect on both sides (docs/scene-format.md: two-sided).
 
 use crate::Rgb;
 use glam::Vec3;

@@ -1,13 +1,15 @@
-//! Rendering an image: tiles over threads (rayon), each pixel with its own
-//! random stream, so the image is the same whatever the thread count.
+//! Rendering an image: tiles over threads (rayon), each sample with its own
+//! random stream, every sample added into one [`Accumulator`], so the image
+//! is the same, bit for bit, whatever the thread count and however the
+//! samples were grouped (one render, progressive passes, shards).
 
-use crate::Rgb;
-use crate::film::Image;
-use crate::integrator::{self, Integrator};
+use crate::film::{Accumulator, Image, PixelSum};
+use crate::integrator::{Integrator, IntegratorError};
 use crate::sampling::Sampler;
 use crate::scene::{PixelFilter, Scene};
 use glam::Vec2;
 use rayon::prelude::*;
+use std::ops::Range;
 use std::sync::atomic::{AtomicBool, Ordering};
 
 const TILE: u32 = 16;
@@ -15,9 +17,11 @@ const TILE: u32 = 16;
 /// Hooks a caller may give a render: progress reports and a stop flag.
 #[derive(Default, Clone, Copy)]
 pub struct RenderObserver<'a> {
-    /// Called with the number of pixels just finished (from any thread).
+    /// Called with the number of pixel samples just finished (from any
+    /// thread).
     pub progress: Option<&'a (dyn Fn(u64) + Sync)>,
-    /// When set, tiles not yet started are skipped and stay black.
+    /// When set, tiles not yet started are skipped: their pixels get no
+    /// samples.
     pub cancel: Option<&'a AtomicBool>,
 }
 
@@ -25,29 +29,21 @@ impl RenderObserver<'_> {
     pub fn none() -> Self {
         RenderObserver::default()
     }
+
+    fn cancelled(&self) -> bool {
+        self.cancel.is_some_and(|c| c.load(Ordering::Relaxed))
+    }
 }
 
-/// Renders `scene` with its settings. Fails only when the scene names an
-/// integrator that cannot render it.
-pub fn try_render(scene: &Scene, observer: &RenderObserver) -> Result<Image, String> {
-    let integrator = integrator::for_scene(scene)?;
-    Ok(render_with(scene, integrator.as_ref(), observer))
-}
-
-/// Renders `scene`; panics if its integrator is not available (see
-/// [`try_render`] for the fallible form).
-pub fn render(scene: &Scene, observer: &RenderObserver) -> Image {
-    try_render(scene, observer).unwrap_or_else(|e| panic!("{e}"))
-}
-
-/// Renders `scene` with a given integrator: `spp` jittered samples per pixel,
-/// box filtered.
-pub fn render_with(scene: &Scene, integrator: &dyn Integrator, observer: &RenderObserver) -> Image {
-    render_samples(scene, integrator, 0, scene.settings.spp, observer)
+/// Renders the scene's `spp` samples of every pixel with `integrator`: each
+/// pixel the mean of its samples (box filtered, unless the scene asks for
+/// point sampling).
+pub fn render(scene: &Scene, integrator: &dyn Integrator, observer: &RenderObserver) -> Image {
+    render_samples(scene, integrator, 0, scene.settings().spp, observer)
 }
 
 /// Renders samples `first .. first + count` of every pixel (sample numbers
-/// count across passes): each pixel is the mean of those samples.
+/// count across passes): each pixel the mean of those samples.
 pub fn render_samples(
     scene: &Scene,
     integrator: &dyn Integrator,
@@ -55,88 +51,74 @@ pub fn render_samples(
     count: u32,
     observer: &RenderObserver,
 ) -> Image {
-    render_moments(scene, integrator, first, count, observer).0
+    let rows = 0..scene.settings().height;
+    accumulate(scene, integrator, first..first + count as u64, rows, observer).image()
 }
 
-/// Like [`render_samples`], with a second image of each pixel's mean of
-/// squared samples (per channel), from which [`Progressive`] estimates the
-/// variance of its pixels.
-pub fn render_moments(
+/// Adds samples `samples` of every pixel in the rows `rows` (pixel and
+/// sample numbers those of the full image) into a new accumulator that
+/// holds those rows.
+pub fn accumulate(
     scene: &Scene,
     integrator: &dyn Integrator,
-    first: u64,
-    count: u32,
+    samples: Range<u64>,
+    rows: Range<u32>,
     observer: &RenderObserver,
-) -> (Image, Image) {
-    let s = &scene.settings;
+) -> Accumulator {
+    let s = scene.settings();
     let (w, h) = (s.width, s.height);
+    let mut acc = Accumulator::band(w, h, rows);
+    let rows = acc.rows();
     let tiles_x = w.div_ceil(TILE);
-    let tiles: Vec<(u32, u32)> = (0..h.div_ceil(TILE)).flat_map(|ty| (0..tiles_x).map(move |tx| (tx, ty))).collect();
-    let rendered: Vec<Vec<Moments>> = tiles
+    let bands = (rows.end - rows.start).div_ceil(TILE);
+    let tiles: Vec<(u32, u32)> = (0..bands).flat_map(|ty| (0..tiles_x).map(move |tx| (tx, ty))).collect();
+    let per_pixel = samples.end.saturating_sub(samples.start);
+    let rendered: Vec<Vec<PixelSum>> = tiles
         .par_iter()
         .map(|&(tx, ty)| {
-            let (x0, y0) = (tx * TILE, ty * TILE);
-            let (x1, y1) = ((x0 + TILE).min(w), (y0 + TILE).min(h));
-            let mut out = Vec::with_capacity(((x1 - x0) * (y1 - y0)) as usize);
-            if observer.cancel.is_some_and(|c| c.load(Ordering::Relaxed)) {
-                out.resize(((x1 - x0) * (y1 - y0)) as usize, Moments::default());
-                return out;
+            let (x0, y0) = (tx * TILE, rows.start + ty * TILE);
+            let (x1, y1) = ((x0 + TILE).min(w), (y0 + TILE).min(rows.end));
+            if observer.cancelled() {
+                return vec![PixelSum::default(); ((x1 - x0) * (y1 - y0)) as usize];
             }
+            let mut out = Vec::with_capacity(((x1 - x0) * (y1 - y0)) as usize);
             for y in y0..y1 {
                 for x in x0..x1 {
-                    out.push(pixel_moments(scene, integrator, x, y, first, count));
+                    out.push(pixel_sum(scene, integrator, x, y, samples.clone()));
                 }
             }
             if let Some(progress) = observer.progress {
-                progress(out.len() as u64);
+                progress(out.len() as u64 * per_pixel);
             }
             out
         })
         .collect();
-    let (mut mean, mut mean_square) = (Image::new(w, h), Image::new(w, h));
     for (&(tx, ty), tile) in tiles.iter().zip(&rendered) {
-        let (x0, y0) = (tx * TILE, ty * TILE);
+        let (x0, y0) = (tx * TILE, rows.start + ty * TILE);
         let tile_w = (x0 + TILE).min(w) - x0;
-        for (i, m) in tile.iter().enumerate() {
+        for (i, sum) in tile.iter().enumerate() {
             let (x, y) = (x0 + i as u32 % tile_w, y0 + i as u32 / tile_w);
-            mean.pixels[(y * w + x) as usize] = m.mean;
-            mean_square.pixels[(y * w + x) as usize] = m.mean_square;
+            if let Some(p) = acc.pixel_mut(x, y) {
+                *p = *sum;
+            }
         }
     }
-    (mean, mean_square)
+    acc
 }
 
-/// The first two moments of a pixel's samples.
-#[derive(Clone, Copy, Default)]
-struct Moments {
-    mean: Rgb,
-    mean_square: Rgb,
-}
-
-/// The mean of `spp` samples of one pixel in pass `pass`.
+/// The samples `samples` of pixel (x, y), summed.
 ///
 /// Each sample draws from its own stream, keyed by (seed, pixel, sample
-/// number), so its camera ray is the same whatever the integrator draws
-/// after it: images of one scene by two integrators share their
-/// anti-aliasing and lens samples, and differ only by what the integrators
-/// compute.
-pub fn render_pixel(scene: &Scene, integrator: &dyn Integrator, x: u32, y: u32, pass: u64) -> Rgb {
-    let spp = scene.settings.spp;
-    pixel_samples(scene, integrator, x, y, pass * spp as u64, spp)
-}
-
-/// The mean of samples `first .. first + count` of one pixel.
-pub fn pixel_samples(scene: &Scene, integrator: &dyn Integrator, x: u32, y: u32, first: u64, count: u32) -> Rgb {
-    pixel_moments(scene, integrator, x, y, first, count).mean
-}
-
-/// The mean and mean square of samples `first .. first + count` of one pixel.
-fn pixel_moments(scene: &Scene, integrator: &dyn Integrator, x: u32, y: u32, first: u64, count: u32) -> Moments {
-    let s = &scene.settings;
+/// number), so it is the same whichever machine, thread or pass renders it,
+/// and its camera ray is the same whatever the integrator draws after it:
+/// images of one scene by two integrators share their anti-aliasing and
+/// lens samples, and differ only by what the integrators compute.
+pub fn pixel_sum(scene: &Scene, integrator: &dyn Integrator, x: u32, y: u32, samples: Range<u64>) -> PixelSum {
+    let s = scene.settings();
     let index = y as u64 * s.width as u64 + x as u64;
-    let (mut sum, mut sum_square) = (Rgb::ZERO, Rgb::ZERO);
-    for i in 0..count as u64 {
-        let mut sampler = Sampler::for_pixel(s.seed, index, first + i);
+    let mut sum = PixelSum::default();
+    for i in samples {
+        let mut sampler = Sampler::for_pixel(s.seed, index, i);
         let (jitter, lens) = if integrator.stratified() {
             let u = sampler.stratified4(0);
             (Vec2::new(u[0], u[1]), Vec2::new(u[2], u[3]))
@@ -148,52 +130,50 @@ fn pixel_moments(scene: &Scene, integrator: &dyn Integrator, x: u32, y: u32, fir
                 PixelFilter::Box => jitter,
                 PixelFilter::Point => Vec2::splat(0.5),
             };
-        let ray = scene.camera.ray(film, s.width, s.height, lens);
-        let l = integrator.radiance(scene, &ray, &mut sampler);
-        // One broken sample (NaN, inf) must not spoil the pixel.
-        if l.is_finite() {
-            sum += l;
-            sum_square += l * l;
-        }
+        let ray = scene.camera().ray(film, s.width, s.height, lens);
+        sum.add(integrator.radiance(scene, &ray, &mut sampler));
     }
-    let n = count.max(1) as f32;
-    Moments { mean: sum / n, mean_square: sum_square / n }
+    sum
+}
+
+/// Moves `scene` to `time` in [0, 1] of its light animation and tells
+/// `integrator`: the one step every command takes between frames (radiosity
+/// relights instead of recompiling).
+pub fn set_time(scene: &mut Scene, integrator: &mut dyn Integrator, time: f32) -> Result<(), IntegratorError> {
+    scene.at_time(time);
+    integrator.lights_changed(scene)
+}
+
+/// The time in [0, 1] of frame `frame` of `frames`: k/(N − 1), so the first
+/// and last frames show the animation's ends.
+pub fn frame_time(frame: u32, frames: u32) -> f32 {
+    if frames > 1 { frame as f32 / (frames - 1) as f32 } else { 0.0 }
 }
 
 /// Progressive rendering: the scene's `spp` samples in passes of 1, 1, 2,
 /// 4, 8, ... samples per pixel (the last one cut to what is left), each
-/// added to a running sum, so that after every pass the image is the mean of
-/// all samples so far. Pass sizes double so that the pixel's stratified
+/// added to the accumulator, so that after every pass the image is the mean
+/// of all samples so far. Pass sizes double so that the pixel's stratified
 /// sequence is always cut at a power of two, where it is best spread, and
 /// the number of passes (and rewrites of the image) grows only as log₂ spp.
-/// The result is a pure function of the scene, as for [`render`], but not
-/// bit for bit the same image: sums are grouped differently.
-///
-/// It also keeps each pixel's sum of squared samples, for the variance of
-/// its mean, s²/n with s² the unbiased sample variance: exact for
-/// independent samples, an upper bound in expectation for stratified ones
-/// (stratification only lowers the variance of the mean).
+/// The finished image is bit for bit the one [`render`] gives (the
+/// accumulator's sums do not depend on grouping).
 pub struct Progressive {
-    width: u32,
-    height: u32,
     spp: u32,
     done: u32,
-    sum: Vec<glam::DVec3>,
-    sum_square: Vec<glam::DVec3>,
+    accumulator: Accumulator,
 }
 
 impl Progressive {
     pub fn new(scene: &Scene) -> Self {
-        let s = &scene.settings;
-        let pixels = s.width as usize * s.height as usize;
-        Progressive {
-            width: s.width,
-            height: s.height,
-            spp: s.spp,
-            done: 0,
-            sum: vec![glam::DVec3::ZERO; pixels],
-            sum_square: vec![glam::DVec3::ZERO; pixels],
-        }
+        let s = scene.settings();
+        Progressive { spp: s.spp, done: 0, accumulator: Accumulator::new(s.width, s.height) }
+    }
+
+    /// Continues from an accumulator that holds the first `done` samples of
+    /// every pixel of the scene's image.
+    pub fn resume(scene: &Scene, accumulator: Accumulator, done: u32) -> Self {
+        Progressive { spp: scene.settings().spp, done, accumulator }
     }
 
     /// Samples per pixel rendered so far.
@@ -208,7 +188,7 @@ impl Progressive {
 
     /// How many samples the next pass renders (0 when finished).
     pub fn next_pass_size(&self) -> u32 {
-        self.done.max(1).min(self.spp - self.done)
+        self.done.max(1).min(self.spp.saturating_sub(self.done))
     }
 
     /// Renders the next pass and adds it in. Returns false, adding nothing,
@@ -219,55 +199,35 @@ impl Progressive {
         if count == 0 {
             return false;
         }
-        let (mean, mean_square) = render_moments(scene, integrator, self.done as u64, count, observer);
-        if observer.cancel.is_some_and(|c| c.load(Ordering::Relaxed)) {
+        let first = self.done as u64;
+        let rows = 0..scene.settings().height;
+        let pass = accumulate(scene, integrator, first..first + count as u64, rows, observer);
+        if observer.cancelled() || self.accumulator.merge(&pass).is_err() {
             return false;
-        }
-        let n = count as f64;
-        for ((acc, acc_square), (p, q)) in
-            self.sum.iter_mut().zip(&mut self.sum_square).zip(mean.pixels.iter().zip(&mean_square.pixels))
-        {
-            *acc += p.as_dvec3() * n;
-            *acc_square += q.as_dvec3() * n;
         }
         self.done += count;
         true
     }
 
+    /// The samples so far.
+    pub fn accumulator(&self) -> &Accumulator {
+        &self.accumulator
+    }
+
     /// The mean of the samples so far (black before the first pass).
     pub fn image(&self) -> Image {
-        let n = self.done.max(1) as f64;
-        let pixels = self.sum.iter().map(|s| (*s / n).as_vec3()).collect();
-        Image { width: self.width, height: self.height, pixels }
+        self.accumulator.image()
     }
 
-    /// The estimated variance of each pixel's mean, per channel: s²/n, with
-    /// s² = (Σx² − (Σx)²/n)/(n − 1). Infinite before two samples.
+    /// The estimated variance of each pixel's mean, per channel (infinite
+    /// before two samples).
     pub fn variance(&self) -> Image {
-        let pixels = self.sum.iter().zip(&self.sum_square).map(|(s, q)| self.variance_of_mean(*s, *q).as_vec3());
-        Image { width: self.width, height: self.height, pixels: pixels.collect() }
+        self.accumulator.variance()
     }
 
-    fn variance_of_mean(&self, sum: glam::DVec3, sum_square: glam::DVec3) -> glam::DVec3 {
-        if self.done < 2 {
-            return glam::DVec3::INFINITY;
-        }
-        let n = self.done as f64;
-        let sample_variance = ((sum_square - sum * sum / n) / (n - 1.0)).max(glam::DVec3::ZERO);
-        sample_variance / n
-    }
-
-    /// The estimated relative error of the image: √(Σ Var(mean) / Σ mean²)
-    /// over pixels and channels, what [`crate::film::compare`]'s `rel_rmse`
-    /// against the converged image is expected to be. Infinite before two
-    /// samples or for a black image.
+    /// The estimated relative error of the image (see
+    /// [`Accumulator::estimated_relative_error`]).
     pub fn estimated_relative_error(&self) -> f64 {
-        let n = self.done.max(1) as f64;
-        let (mut variance, mut signal) = (0.0, 0.0);
-        for (s, q) in self.sum.iter().zip(&self.sum_square) {
-            variance += self.variance_of_mean(*s, *q).element_sum();
-            signal += (*s / n).length_squared();
-        }
-        if signal > 0.0 { (variance / signal).sqrt() } else { f64::INFINITY }
+        self.accumulator.estimated_relative_error()
     }
 }

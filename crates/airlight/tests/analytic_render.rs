@@ -3,10 +3,11 @@
 //! lights a 4096-point superposition.
 
 use airlight::film::{self, Image};
+use airlight::integrator::RaymarchOptions;
 use airlight::integrator::analytic::{Analytic, AnalyticOptions, LightQuadrature};
-use airlight::integrator::{self, Integrator, Raymarch};
+use airlight::integrator::{Integrator, Raymarch};
 use airlight::prelude::*;
-use airlight::render::render_with;
+use airlight::render::render;
 use airlight::sampling::Sampler;
 use glam::Vec2;
 use rayon::prelude::*;
@@ -14,9 +15,18 @@ use std::path::PathBuf;
 
 mod common;
 
-fn scene_file(name: &str) -> Scene {
+fn file(name: &str) -> SceneFile {
     let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../scenes").join(name);
-    airlight::scene::load(&path).unwrap_or_else(|e| panic!("{e}"))
+    SceneFile::load(&path).unwrap_or_else(|e| panic!("{e}"))
+}
+
+fn scene_file(name: &str) -> Scene {
+    file(name).scene
+}
+
+/// The integrator a scene file names, or why it cannot be had.
+fn build(file: &SceneFile) -> Result<Box<dyn Integrator>, String> {
+    file.integrator.build(&file.scene).map_err(|e| e.to_string())
 }
 
 fn analytic(scene: &Scene, shadows: bool, light_steps: u32, quadrature: LightQuadrature) -> Analytic {
@@ -27,7 +37,7 @@ fn analytic(scene: &Scene, shadows: bool, light_steps: u32, quadrature: LightQua
 /// same rays whatever the integrator, each with its own random stream; so
 /// two integrators' images differ only by what they compute along a ray.
 fn same_rays(scene: &Scene, integrator: &dyn Integrator, per_side: u32) -> Image {
-    let (w, h) = (scene.settings.width, scene.settings.height);
+    let (w, h) = (scene.settings().width, scene.settings().height);
     let rows: Vec<Vec<Rgb>> = (0..h)
         .into_par_iter()
         .map(|y| {
@@ -40,7 +50,7 @@ fn same_rays(scene: &Scene, integrator: &dyn Integrator, per_side: u32) -> Image
                             x as f32 + (i as f32 + 0.5) / per_side as f32,
                             y as f32 + (j as f32 + 0.5) / per_side as f32,
                         );
-                        let ray = scene.camera.ray(film, w, h, Vec2::splat(0.5));
+                        let ray = scene.camera().ray(film, w, h, Vec2::splat(0.5));
                         let mut sampler = Sampler::for_pixel(7, (y * w + x) as u64, k as u64);
                         sum += integrator.radiance(scene, &ray, &mut sampler);
                     }
@@ -53,9 +63,9 @@ fn same_rays(scene: &Scene, integrator: &dyn Integrator, per_side: u32) -> Image
 }
 
 fn small(mut scene: Scene, w: u32, h: u32) -> Scene {
-    scene.settings.width = w;
-    scene.settings.height = h;
-    scene.settings.spp = 1;
+    scene.settings_mut().width = w;
+    scene.settings_mut().height = h;
+    scene.settings_mut().spp = 1;
     scene
 }
 
@@ -64,10 +74,9 @@ fn glow_scene_matches_raymarch_at_4096_steps() {
     // One sample per pixel: both integrators trace the same camera ray (the
     // first two numbers of each pixel's stream), and without jitter the
     // march is deterministic, so the images differ only by the integrals.
-    let mut scene = small(scene_file("glow.toml"), 64, 48);
-    scene.settings.jitter = false;
-    let an = render_with(&scene, &analytic(&scene, false, 16, LightQuadrature::Gauss), &RenderObserver::none());
-    let rm = render_with(&scene, &Raymarch { steps: 4096, jitter: false }, &RenderObserver::none());
+    let scene = small(scene_file("glow.toml"), 64, 48);
+    let an = render(&scene, &analytic(&scene, false, 16, LightQuadrature::Gauss), &RenderObserver::none());
+    let rm = render(&scene, &Raymarch::new(RaymarchOptions { steps: 4096, jitter: false }), &RenderObserver::none());
     let e = film::compare(&an, &rm).unwrap();
     println!("glow: analytic vs raymarch 4096: rel_rmse {:.3e}", e.rel_rmse);
     assert!(e.rel_rmse <= 0.005, "{e:?}");
@@ -112,9 +121,9 @@ fn spot_light_with_soft_edge_anisotropic_phase_and_coloured_medium_matches_rayma
             profile = "{profile}"
             "#
         );
-        let scene = airlight::scene::from_toml_str(&text, None).unwrap();
+        let scene = SceneFile::from_toml_str(&text, None).unwrap().scene;
         let an = same_rays(&scene, &analytic(&scene, false, 16, LightQuadrature::Gauss), 1);
-        let rm = same_rays(&scene, &Raymarch { steps: 32768, jitter: false }, 1);
+        let rm = same_rays(&scene, &Raymarch::new(RaymarchOptions { steps: 32768, jitter: false }), 1);
         let e = film::compare(&an, &rm).unwrap();
         println!("spot g={g} {profile}: analytic vs raymarch 32768: rel_rmse {:.3e}", e.rel_rmse);
         assert!(e.rel_rmse <= 0.005, "g={g}: {e:?}");
@@ -146,7 +155,7 @@ fn area_scene(light: &str) -> Scene {
         {light}
         "#
     );
-    airlight::scene::from_toml_str(&text, None).unwrap()
+    SceneFile::from_toml_str(&text, None).unwrap().scene
 }
 
 #[test]
@@ -193,7 +202,7 @@ fn line_quad_and_sphere_lights_match_raymarch() {
     for light in lights {
         let scene = area_scene(light);
         let an = same_rays(&scene, &analytic(&scene, false, 16, LightQuadrature::Gauss), 2);
-        let rm = same_rays(&scene, &Raymarch { steps: 4096, jitter: true }, 2);
+        let rm = same_rays(&scene, &Raymarch::new(RaymarchOptions { steps: 4096, jitter: true }), 2);
         let e = film::compare(&an, &rm).unwrap();
         println!("{}: analytic vs raymarch: rel_rmse {:.3e}", light.lines().nth(1).unwrap(), e.rel_rmse);
         assert!(e.rel_rmse <= 0.01, "{light}: {e:?}");
@@ -202,10 +211,10 @@ fn line_quad_and_sphere_lights_match_raymarch() {
 
 #[test]
 fn volumetric_shadows_match_raymarch_with_jitter() {
+    assert!(file("shadow_spheres.toml").integrator.analytic.shadows);
     let scene = small(scene_file("shadow_spheres.toml"), 48, 36);
-    assert!(scene.settings.shadows);
     let an = same_rays(&scene, &analytic(&scene, true, 16, LightQuadrature::Gauss), 2);
-    let rm = same_rays(&scene, &Raymarch { steps: 4096, jitter: true }, 2);
+    let rm = same_rays(&scene, &Raymarch::new(RaymarchOptions { steps: 4096, jitter: true }), 2);
     let e = film::compare(&an, &rm).unwrap();
     println!("shadows: analytic vs raymarch 4096 jittered: rel_rmse {:.3e}", e.rel_rmse);
     assert!(e.rel_rmse <= 0.01, "{e:?}");
@@ -249,7 +258,7 @@ fn mesh_shadows_by_march_and_bisection_match_raymarch() {
         .build()
         .unwrap();
     let an = same_rays(&scene, &analytic(&scene, true, 16, LightQuadrature::Gauss), 2);
-    let rm = same_rays(&scene, &Raymarch { steps: 4096, jitter: true }, 2);
+    let rm = same_rays(&scene, &Raymarch::new(RaymarchOptions { steps: 4096, jitter: true }), 2);
     let e = film::compare(&an, &rm).unwrap();
     println!("mesh shadows: analytic vs raymarch: rel_rmse {:.3e}", e.rel_rmse);
     assert!(e.rel_rmse <= 0.01, "{e:?}");
@@ -257,14 +266,17 @@ fn mesh_shadows_by_march_and_bisection_match_raymarch() {
 
 #[test]
 fn images_do_not_depend_on_the_thread_count() {
-    let scene = small(scene_file("shadow_spheres.toml"), 32, 24);
-    let integrator = integrator::for_scene(&scene).unwrap();
+    let mut file = file("shadow_spheres.toml");
+    let s = file.scene.settings_mut();
+    (s.width, s.height, s.spp) = (32, 24, 1);
+    let integrator = build(&file).unwrap();
+    let scene = file.scene;
     let render = |threads: usize| {
         rayon::ThreadPoolBuilder::new()
             .num_threads(threads)
             .build()
             .unwrap()
-            .install(|| render_with(&scene, integrator.as_ref(), &RenderObserver::none()))
+            .install(|| render(&scene, integrator.as_ref(), &RenderObserver::none()))
     };
     assert_eq!(render(1), render(2));
 }
@@ -281,34 +293,34 @@ fn scenes_the_analytic_integrator_cannot_render_say_why() {
     let sun = "[[lights]]\ntype = \"distant\"\ndirection = [0, -1, 0]\nirradiance = 1";
     let height = "[medium]\ntype = \"height\"\nsigma_s = 0.1";
     let fog = "[medium]\nsigma_s = 0.1";
-    let scene = airlight::scene::from_toml_str(&base(height, point), None).unwrap();
-    let err = integrator::for_scene(&scene).err().unwrap();
+    let scene = SceneFile::from_toml_str(&base(height, point), None).unwrap();
+    let err = build(&scene).err().unwrap();
     assert!(err.contains("homogeneous"), "{err}");
-    let scene = airlight::scene::from_toml_str(&base(fog, sun), None).unwrap();
-    let err = integrator::for_scene(&scene).err().unwrap();
+    let scene = SceneFile::from_toml_str(&base(fog, sun), None).unwrap();
+    let err = build(&scene).err().unwrap();
     assert!(err.contains("distant"), "{err}");
     // A sun without a medium lights surfaces only: fine.
-    let scene = airlight::scene::from_toml_str(&base("", sun), None).unwrap();
-    assert!(integrator::for_scene(&scene).is_ok());
+    let scene = SceneFile::from_toml_str(&base("", sun), None).unwrap();
+    assert!(build(&scene).is_ok());
     // A volume light.
     let volume = "[[lights]]\ntype = \"box\"\nmin = [-0.4, 2.6, -0.4]\nmax = [0.4, 3.4, 0.4]\nintensity = 30.0";
-    let scene = airlight::scene::from_toml_str(&base(fog, volume), None).unwrap();
-    let err = integrator::for_scene(&scene).err().unwrap();
+    let scene = SceneFile::from_toml_str(&base(fog, volume), None).unwrap();
+    let err = build(&scene).err().unwrap();
     assert!(err.contains("volume light"), "{err}");
     // A real-time attenuation window: the closed form is for 1/r² only.
     let windowed = format!("{point}\nattenuation = \"window_ue4\"\nrange = 5.0");
-    let scene = airlight::scene::from_toml_str(&base(fog, &windowed), None).unwrap();
-    let err = integrator::for_scene(&scene).err().unwrap();
+    let scene = SceneFile::from_toml_str(&base(fog, &windowed), None).unwrap();
+    let err = build(&scene).err().unwrap();
     assert!(err.contains("attenuation"), "{err}");
     // SDF objects with shadows (without shadows they only end rays: fine).
     let sdf = "[[objects]]\ntype = \"sdf\"\nmaterial = \"m\"\nshape = \"box\"\nmin = [2, 0, 2]\nmax = [3, 1, 3]";
     let with_sdf = |shadows: bool| {
         let text = base(fog, point).replacen("[render]\n", &format!("[render]\nshadows = {shadows}\n"), 1);
-        airlight::scene::from_toml_str(&format!("{text}\n{sdf}"), None).unwrap()
+        SceneFile::from_toml_str(&format!("{text}\n{sdf}"), None).unwrap()
     };
-    let err = integrator::for_scene(&with_sdf(true)).err().unwrap();
+    let err = build(&with_sdf(true)).err().unwrap();
     assert!(err.contains("SDF"), "{err}");
-    assert!(integrator::for_scene(&with_sdf(false)).is_ok());
+    assert!(build(&with_sdf(false)).is_ok());
 }
 
 #[test]
@@ -323,7 +335,7 @@ fn anisotropic_phase_along_rays_matches_numeric_integration() {
             .light(Light::point(light, Rgb::splat(intensity)))
             .build()
             .unwrap();
-        let medium = scene.medium.unwrap();
+        let medium = scene.medium().unwrap();
         let integrator = analytic(&scene, false, 16, LightQuadrature::Gauss);
         let mut worst = 0.0f64;
         for i in 0..200 {
@@ -332,7 +344,7 @@ fn anisotropic_phase_along_rays_matches_numeric_integration() {
             let origin = vec3(0.0, 1.5, -4.0 + (i % 7) as f32);
             let t_end = 3.0 + (i % 11) as f32 * 2.0;
             let ray = airlight::geometry::Ray::new(origin, dir);
-            let got = integrator.in_scattered(&scene, &medium, &ray, t_end).x as f64;
+            let got = integrator.in_scattered(&scene, medium, &ray, t_end).x as f64;
             let (o, d, p) = (origin.as_dvec3(), dir.as_dvec3(), light.as_dvec3());
             let st = (sigma_a + sigma_s) as f64;
             let f = |t: f64| {

@@ -3,7 +3,7 @@
 use airlight::integrator::Direct;
 use airlight::light::{Attenuation, AttenuationModel};
 use airlight::prelude::*;
-use airlight::render::render_with;
+use airlight::render::render;
 use airlight::sampling::Sampler;
 
 /// A floor with 1,000 small lights of short range above it (and one light
@@ -43,8 +43,8 @@ pub fn many_lights(cull: bool) -> Scene {
 
 #[test]
 fn culling_lights_out_of_range_leaves_the_image_unchanged() {
-    let culled = render_with(&many_lights(true), &Direct, &RenderObserver::none());
-    let full = render_with(&many_lights(false), &Direct, &RenderObserver::none());
+    let culled = render(&many_lights(true), &Direct, &RenderObserver::none());
+    let full = render(&many_lights(false), &Direct, &RenderObserver::none());
     let worst =
         culled.pixels.iter().zip(&full.pixels).map(|(a, b)| (*a - *b).abs().max_element()).fold(0.0f32, f32::max);
     assert!(worst <= 1e-6, "largest difference {worst}");

@@ -1,9 +1,11 @@
 //! The `direct` integrator against closed forms, and rendering's determinism.
 
 use airlight::geometry::Ray;
+use airlight::integrator::PathOptions;
+use airlight::integrator::RaymarchOptions;
 use airlight::integrator::{Direct, Integrator};
 use airlight::prelude::*;
-use airlight::render::render_with;
+use airlight::render::render;
 use airlight::sampling::Sampler;
 
 #[test]
@@ -81,7 +83,7 @@ fn image_does_not_depend_on_thread_count() {
     let scene = busy_scene();
     let render_on = |threads| {
         let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
-        pool.install(|| render_with(&scene, &Direct, &RenderObserver::none()))
+        pool.install(|| render(&scene, &Direct, &RenderObserver::none()))
     };
     let one = render_on(1);
     assert!(one == render_on(2), "1 and 2 threads differ");
@@ -132,10 +134,10 @@ fn quad_light_on_a_floor_through_the_integrators_matches_lambert() {
     let expected = lambert_irradiance(corner, u, v, 1.0) / std::f64::consts::PI;
     for (name, integrator) in [
         ("direct", &Direct as &dyn Integrator),
-        ("path", &airlight::integrator::PathTracer::new(1)),
-        ("raymarch", &airlight::integrator::Raymarch { steps: 4, jitter: true }),
+        ("path", &airlight::integrator::PathTracer::new(PathOptions { max_depth: 1 })),
+        ("raymarch", &airlight::integrator::Raymarch::new(RaymarchOptions { steps: 4, jitter: true })),
     ] {
-        let got = render_with(&scene, integrator, &RenderObserver::none()).mean().x as f64;
+        let got = render(&scene, integrator, &RenderObserver::none()).mean().x as f64;
         assert!((got / expected - 1.0).abs() < 0.01, "{name}: {got} vs {expected}");
     }
 }

@@ -2,10 +2,12 @@
 
 use airlight::film::compare;
 use airlight::geometry::Ray;
+use airlight::integrator::PathOptions;
+use airlight::integrator::RaymarchOptions;
 use airlight::integrator::path::tracking::{delta_tracking_passes, ratio_tracking, track};
 use airlight::integrator::{PathTracer, Raymarch};
 use airlight::prelude::*;
-use airlight::render::render_with;
+use airlight::render::render;
 use airlight::sampling::Sampler;
 
 /// Inside a sphere that emits radiance 1 inward, filled with a medium that
@@ -19,7 +21,6 @@ fn furnace(medium: Medium) -> Scene {
         .size(16, 12)
         .with_settings(|s| {
             s.spp = 64;
-            s.max_depth = 10_000;
             s.max_distance = 100.0;
         })
         .camera(Camera::look_at(vec3(0.3, -0.5, 0.2), vec3(1.0, 0.0, 0.5), Vec3::Y, 90.0))
@@ -36,7 +37,8 @@ fn white_furnace_gives_the_wall_radiance_everywhere() {
         Medium::homogeneous(Rgb::ZERO, Rgb::splat(1.5), 0.7),
         Medium::height(Rgb::ZERO, Rgb::new(0.8, 0.4, 1.2), -0.3, -1.0, 0.9),
     ] {
-        let image = render_with(&furnace(medium), &PathTracer::new(10_000), &RenderObserver::none());
+        let image =
+            render(&furnace(medium), &PathTracer::new(PathOptions { max_depth: 10_000 }), &RenderObserver::none());
         // The image mean against 1, within four standard errors (measured
         // from the spread of the pixels, which are independent).
         let mean = image.mean();
@@ -139,9 +141,16 @@ fn single_scattering_path_tracing_agrees_with_marching() {
         Medium::homogeneous(Rgb::new(0.02, 0.03, 0.04), Rgb::new(0.10, 0.07, 0.05), 0.3),
         Medium::height(Rgb::splat(0.02), Rgb::splat(0.15), 0.0, 0.0, 0.4),
     ] {
-        let path = render_with(&fog_scene(medium, 32_768, 0), &PathTracer::new(1), &RenderObserver::none());
-        let marched =
-            render_with(&fog_scene(medium, 16, 0), &Raymarch { steps: 4096, jitter: true }, &RenderObserver::none());
+        let path = render(
+            &fog_scene(medium, 32_768, 0),
+            &PathTracer::new(PathOptions { max_depth: 1 }),
+            &RenderObserver::none(),
+        );
+        let marched = render(
+            &fog_scene(medium, 16, 0),
+            &Raymarch::new(RaymarchOptions { steps: 4096, jitter: true }),
+            &RenderObserver::none(),
+        );
         let e = compare(&path, &marched).unwrap();
         assert!(e.rel_rmse < 0.01, "{medium:?}: relative RMSE {}", e.rel_rmse);
         // The shadow is in the picture: the darkest floor pixel is well
@@ -162,14 +171,16 @@ fn equiangular_light_sampling_lowers_the_error_near_lights() {
     let medium = Medium::homogeneous(Rgb::new(0.02, 0.03, 0.04), Rgb::new(0.10, 0.07, 0.05), 0.3);
     let in_view = |spp| {
         let mut scene = fog_scene(medium, spp, 5);
-        scene.lights[0] = Light::point(vec3(0.5, 1.5, 1.0), Rgb::splat(60.0));
-        scene.light_culling = airlight::scene::LightCulling::new(&scene.lights);
+        let mut lights = scene.lights().to_vec();
+        lights[0] = Light::point(vec3(0.5, 1.5, 1.0), Rgb::splat(60.0));
+        scene.set_lights(&lights);
         scene
     };
-    let marched = render_with(&in_view(16), &Raymarch { steps: 4096, jitter: true }, &RenderObserver::none());
+    let marched =
+        render(&in_view(16), &Raymarch::new(RaymarchOptions { steps: 4096, jitter: true }), &RenderObserver::none());
     let error = |equiangular| {
         let tracer = PathTracer { max_depth: 1, equiangular };
-        compare(&render_with(&in_view(64), &tracer, &RenderObserver::none()), &marched).unwrap().rel_rmse
+        compare(&render(&in_view(64), &tracer, &RenderObserver::none()), &marched).unwrap().rel_rmse
     };
     let (free_flight, with_equiangular) = (error(false), error(true));
     eprintln!("64 spp: free flights {free_flight:.4}, with equiangular {with_equiangular:.4}");

@@ -10,12 +10,12 @@ use airlight::render::Progressive;
 /// 1/r² in the fog around it gives the path tracer heavy-tailed samples,
 /// for which s² is typically low (with 16 samples a point light beside the
 /// sphere gave an estimate of 0.34 against a true error of 0.41).
-fn scene(integrator: IntegratorKind, spp: u32, seed: u64) -> Scene {
+fn scene(spp: u32, seed: u64) -> Scene {
     SceneBuilder::new()
         .size(32, 24)
         .camera(Camera::look_at(vec3(0.0, 1.5, -5.0), vec3(0.0, 0.8, 0.0), Vec3::Y, 45.0))
         .with_settings(|s| {
-            (s.integrator, s.spp, s.seed, s.max_depth, s.max_distance) = (integrator, spp, seed, 2, 12.0);
+            (s.spp, s.seed, s.max_distance) = (spp, seed, 12.0);
         })
         .material("m", Material::diffuse(Rgb::splat(0.6)))
         .medium(Medium::homogeneous(Rgb::splat(0.02), Rgb::splat(0.08), 0.0))
@@ -26,9 +26,21 @@ fn scene(integrator: IntegratorKind, spp: u32, seed: u64) -> Scene {
         .unwrap()
 }
 
+/// The integrator `kind`; the path tracer at two scattering events.
+fn integrator(kind: IntegratorKind, scene: &Scene) -> Box<dyn airlight::integrator::Integrator> {
+    let mut desc = IntegratorDesc::new(kind);
+    desc.path.max_depth = 2;
+    desc.build(scene).unwrap()
+}
+
+fn render(kind: IntegratorKind, spp: u32, seed: u64) -> Image {
+    let scene = scene(spp, seed);
+    airlight::render(&scene, integrator(kind, &scene).as_ref(), &RenderObserver::none())
+}
+
 /// The progressive render of `scene` and its estimated relative error.
-fn progressive(scene: &Scene) -> Progressive {
-    let integrator = airlight::integrator::for_scene(scene).unwrap();
+fn progressive(kind: IntegratorKind, scene: &Scene) -> Progressive {
+    let integrator = integrator(kind, scene);
     let mut progressive = Progressive::new(scene);
     while !progressive.finished() {
         assert!(progressive.pass(scene, integrator.as_ref(), &RenderObserver::none()));
@@ -43,8 +55,8 @@ fn estimated_error_matches_the_true_error_of_independent_samples() {
     // to the error against a reference of 64× the samples (whose own error,
     // 1/8 of the image's, adds under 1% in quadrature).
     for spp in [16, 64] {
-        let image = progressive(&scene(IntegratorKind::Path, spp, 1));
-        let reference = airlight::render(&scene(IntegratorKind::Path, 64 * spp, 99), &RenderObserver::none());
+        let image = progressive(IntegratorKind::Path, &scene(spp, 1));
+        let reference = render(IntegratorKind::Path, 64 * spp, 99);
         let actual = compare(&image.image(), &reference).unwrap().rel_rmse;
         let estimated = image.estimated_relative_error();
         eprintln!("{spp} spp: estimated {estimated:.4}, actual {actual:.4}");
@@ -56,8 +68,8 @@ fn estimated_error_matches_the_true_error_of_independent_samples() {
 fn estimated_error_bounds_the_error_of_stratified_samples() {
     // Stratified samples are not independent: s²/n overestimates the
     // variance of their mean, never underestimates it (in expectation).
-    let image = progressive(&scene(IntegratorKind::Stochastic, 64, 1));
-    let reference = airlight::render(&scene(IntegratorKind::Stochastic, 4096, 99), &RenderObserver::none());
+    let image = progressive(IntegratorKind::Stochastic, &scene(64, 1));
+    let reference = render(IntegratorKind::Stochastic, 4096, 99);
     let actual = compare(&image.image(), &reference).unwrap().rel_rmse;
     let estimated = image.estimated_relative_error();
     eprintln!("stratified, 64 spp: estimated {estimated:.4}, actual {actual:.4}");
@@ -68,8 +80,8 @@ fn estimated_error_bounds_the_error_of_stratified_samples() {
 fn variance_image_is_the_per_pixel_share_of_the_estimate() {
     // Σ variance over pixels and channels / Σ mean² = estimate²; before
     // two samples the variance is unknown (infinite), not zero.
-    let scene = scene(IntegratorKind::Path, 8, 3);
-    let integrator = airlight::integrator::for_scene(&scene).unwrap();
+    let scene = scene(8, 3);
+    let integrator = integrator(IntegratorKind::Path, &scene);
     let mut p = Progressive::new(&scene);
     assert!(p.pass(&scene, integrator.as_ref(), &RenderObserver::none()));
     assert!(p.variance().pixels.iter().all(|v| v.x == f32::INFINITY));

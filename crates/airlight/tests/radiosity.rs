@@ -2,22 +2,27 @@
 //! (settings, keyframes).
 
 use airlight::geometry::{Ray, Shape};
-use airlight::integrator::{Direct, RadiosityIntegrator};
+use airlight::integrator::{Direct, RadiosityIntegrator, RadiosityOptions, RaymarchOptions};
 use airlight::prelude::*;
 use airlight::radiosity::Radiosity;
-use airlight::render::render_with;
+use airlight::render::render;
 use airlight::sampling::Sampler;
-use airlight::scene::from_toml_str;
 use std::f32::consts::PI;
 
 const CORNELL: &str = include_str!("../../../scenes/cornell_box.toml");
 const ROOM: &str = include_str!("../../../scenes/room_moving_lights.toml");
 
-fn cornell(patch_size: f32) -> Scene {
-    let mut scene = from_toml_str(CORNELL, None).unwrap();
-    scene.settings.patch_size = Some(patch_size);
-    scene.settings.bounces = 1;
-    scene
+fn cornell() -> Scene {
+    SceneFile::from_toml_str(CORNELL, None).unwrap().scene
+}
+
+/// One bounce with patches of `patch_size`.
+fn options(patch_size: f32) -> RadiosityOptions {
+    RadiosityOptions { patch_size: Some(patch_size), bounces: 1, ..RadiosityOptions::default() }
+}
+
+fn integrator(scene: &Scene, patch_size: f32) -> RadiosityIntegrator {
+    RadiosityIntegrator::new(scene, options(patch_size), RaymarchOptions::default()).unwrap()
 }
 
 /// Direct irradiance at `y` on the side facing along `n` from the quad light,
@@ -25,7 +30,7 @@ fn cornell(patch_size: f32) -> Scene {
 /// E = (A/K) Σ L cos θ_y cos θ_l V / r². Written here, apart from the
 /// library's light sampling, as the independent estimator.
 fn quad_light_irradiance(scene: &Scene, y: Vec3, n: Vec3, k: usize, s: &mut Sampler) -> Rgb {
-    let Light::Quad { corner, edge_u, edge_v, radiance } = scene.lights[0] else {
+    let Light::Quad { corner, edge_u, edge_v, radiance } = scene.lights()[0] else {
         panic!("the Cornell box has one quad light");
     };
     let cross = edge_u.cross(edge_v);
@@ -42,7 +47,7 @@ fn quad_light_irradiance(scene: &Scene, y: Vec3, n: Vec3, k: usize, s: &mut Samp
             continue;
         }
         let origin = y + n * 1e-4;
-        if scene.geometry.occluded(origin, w, r2.sqrt() * (1.0 - 1e-3)) {
+        if scene.geometry().occluded(origin, w, r2.sqrt() * (1.0 - 1e-3)) {
             continue;
         }
         sum += radiance * (cos_y * cos_l / r2);
@@ -66,14 +71,14 @@ fn monte_carlo_wall(scene: &Scene, corner: Vec3, u: Vec3, v: Vec3, inward: Vec3,
         let z = (1.0 - r * r).max(0.0).sqrt();
         let w = t * (r * phi.cos()) + b * (r * phi.sin()) + inward * z;
         let ray = Ray::new(x + inward * 1e-4, w);
-        let Some(hit) = scene.geometry.intersect(&ray, f32::INFINITY) else {
+        let Some(hit) = scene.geometry().intersect(&ray, f32::INFINITY) else {
             continue;
         };
-        let surf = scene.geometry.surface(&ray, hit);
+        let surf = scene.geometry().surface(&ray, hit);
         if surf.emitter.is_some() {
             continue;
         }
-        let albedo = scene.materials[surf.material as usize].albedo(surf.p, surf.n);
+        let albedo = scene.materials()[surf.material as usize].albedo(surf.p, surf.n);
         let n_y = if surf.n.dot(w) < 0.0 { surf.n } else { -surf.n };
         sum += albedo * quad_light_irradiance(scene, surf.p, n_y, 4, &mut s);
     }
@@ -85,10 +90,10 @@ fn cornell_box_one_bounce_matches_monte_carlo() {
     // Each wall's mean one-bounce radiance (ρ/π · mean indirect irradiance)
     // from radiosity within 5% of the Monte Carlo estimate (whose own
     // standard error here is about 1%).
-    let scene = cornell(0.2);
-    let r = Radiosity::compile(&scene).unwrap();
+    let scene = cornell();
+    let r = Radiosity::compile(&scene, &options(0.2)).unwrap();
     let middle = Vec3::new(2.78, 2.74, 2.8);
-    for (object, (shape, material)) in scene.objects.iter().enumerate().take(5) {
+    for (object, (shape, material)) in scene.objects().iter().enumerate().take(5) {
         let Shape::Quad { corner, edge_u, edge_v } = shape else {
             panic!("walls are quads");
         };
@@ -103,7 +108,7 @@ fn cornell_box_one_bounce_matches_monte_carlo() {
                 area += p.area;
             }
         }
-        let albedo = scene.materials[*material as usize].albedo(*corner, inward);
+        let albedo = scene.materials()[*material as usize].albedo(*corner, inward);
         let radiosity = albedo * (e / area) / PI;
         let reference = albedo * monte_carlo_wall(&scene, *corner, *edge_u, *edge_v, inward, 20_000) / PI;
         let (a, b) = (radiosity.element_sum(), reference.element_sum());
@@ -117,13 +122,20 @@ fn radiosity_image_is_the_direct_image_plus_indirect_light() {
     // Without a medium the integrator draws the same samples as `direct`,
     // so every pixel differs by the indirect light alone: never negative,
     // and positive on the walls.
-    let mut scene = cornell(0.4);
-    scene.settings.width = 32;
-    scene.settings.height = 32;
-    scene.settings.spp = 2;
-    let radiosity = RadiosityIntegrator::new(&scene).unwrap();
-    let a = render_with(&scene, &radiosity, &RenderObserver::none());
-    let b = render_with(&scene, &Direct, &RenderObserver::none());
+    let scene = cornell();
+    let with_fog = |fog: &str| {
+        let mut scene = SceneFile::from_toml_str(&format!("{CORNELL}\n{fog}"), None).unwrap().scene;
+        let s = scene.settings_mut();
+        (s.width, s.height, s.spp) = (32, 32, 2);
+        scene
+    };
+    let scene = {
+        drop(scene);
+        with_fog("")
+    };
+    let radiosity = integrator(&scene, 0.4);
+    let a = render(&scene, &radiosity, &RenderObserver::none());
+    let b = render(&scene, &Direct, &RenderObserver::none());
     for (x, y) in a.pixels.iter().zip(&b.pixels) {
         assert!((*x - *y).min_element() >= -1e-6, "{x} < {y}");
     }
@@ -131,8 +143,8 @@ fn radiosity_image_is_the_direct_image_plus_indirect_light() {
         a.pixels.iter().zip(&b.pixels).filter(|(x, y)| x.element_sum() > 1.1 * y.element_sum() + 1e-4).count();
     assert!(brighter * 2 > a.pixels.len(), "{brighter} of {}", a.pixels.len());
     // In fog the result is finite and dimmer with more fog.
-    scene.medium = Some(Medium::homogeneous(Rgb::splat(0.2), Rgb::splat(0.05), 0.0));
-    let fog = render_with(&scene, &radiosity, &RenderObserver::none());
+    let foggy = with_fog("[medium]\nsigma_a = 0.2\nsigma_s = 0.05\n");
+    let fog = render(&foggy, &radiosity, &RenderObserver::none());
     assert!(fog.pixels.iter().all(|p| p.is_finite()));
     assert!(fog.mean().element_sum() < a.mean().element_sum());
 }
@@ -141,27 +153,26 @@ fn radiosity_image_is_the_direct_image_plus_indirect_light() {
 fn the_moving_lights_room_renders_a_frame() {
     // Relit at mid-animation with no recompile; the frame is finite, and
     // the bounce light adds to what the lights reach directly.
-    let mut scene = from_toml_str(ROOM, None).unwrap();
-    scene.settings.patch_size = Some(0.5);
-    scene.settings.width = 24;
-    scene.settings.height = 16;
-    scene.settings.spp = 1;
-    let mut integrator = RadiosityIntegrator::new(&scene).unwrap();
-    scene.lights = scene.lights_at(0.5);
-    integrator.solution.update(&scene);
-    let image = render_with(&scene, &integrator, &RenderObserver::none());
-    let direct = render_with(&scene, &Direct, &RenderObserver::none());
+    let mut scene = SceneFile::from_toml_str(ROOM, None).unwrap().scene;
+    let s = scene.settings_mut();
+    (s.width, s.height, s.spp) = (24, 16, 1);
+    let mut integrator = integrator(&scene, 0.5);
+    let compiled = Radiosity::compile_count();
+    airlight::render::set_time(&mut scene, &mut integrator, 0.5).unwrap();
+    assert_eq!(Radiosity::compile_count(), compiled, "relit, not recompiled");
+    let image = render(&scene, &integrator, &RenderObserver::none());
+    let direct = render(&scene, &Direct, &RenderObserver::none());
     assert!(image.pixels.iter().all(|p| p.is_finite()));
     assert!(image.mean().element_sum() > 1.1 * direct.mean().element_sum());
 }
 
 #[test]
 fn keyframes_move_lights_linearly() {
-    let scene = from_toml_str(ROOM, None).unwrap();
+    let scene = SceneFile::from_toml_str(ROOM, None).unwrap().scene;
     assert!(scene.is_animated());
-    let path = scene.light_paths.iter().flatten().next().unwrap();
+    let path = scene.light_paths().iter().flatten().next().unwrap();
     let keys = path.keys().to_vec();
-    let (i, _) = scene.light_paths.iter().enumerate().find(|(_, p)| p.is_some()).unwrap();
+    let (i, _) = scene.light_paths().iter().enumerate().find(|(_, p)| p.is_some()).unwrap();
     for w in keys.windows(2) {
         let ((t0, p0), (t1, p1)) = (w[0], w[1]);
         let mid = scene.lights_at(0.5 * (t0 + t1))[i].position().unwrap();
@@ -171,7 +182,7 @@ fn keyframes_move_lights_linearly() {
 }
 
 fn error_of(text: &str) -> airlight::scene::SceneError {
-    match from_toml_str(text, None) {
+    match SceneFile::from_toml_str(text, None) {
         Ok(_) => panic!("should be rejected:\n{text}"),
         Err(e) => e,
     }
@@ -211,7 +222,7 @@ fn bad_keyframes_and_settings_name_their_place() {
         (
             "[render]\nbounces = 0\n".into(),
             2,
-            "render.bounces must be an integer ≥ 1",
+            "render.bounces must be an integer from 1 to 1024",
         ),
         (
             "[render]\npatch_size = -1.0\n".into(),
@@ -219,9 +230,9 @@ fn bad_keyframes_and_settings_name_their_place() {
             "render.patch_size must be a positive",
         ),
         (
-            "[render]\nlink_threshold = 0\n".into(),
+            "[render]\nlink_threshold = -0.5\n".into(),
             2,
-            "render.link_threshold must be a positive",
+            "render.link_threshold must be a finite number ≥ 0",
         ),
     ];
     for (text, line, phrase) in cases {

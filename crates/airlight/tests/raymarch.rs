@@ -1,9 +1,10 @@
 //! The ray-marching integrator against independent single-scatter integrals.
 
 use airlight::geometry::Ray;
+use airlight::integrator::RaymarchOptions;
 use airlight::integrator::{Direct, Integrator, Raymarch};
 use airlight::prelude::*;
-use airlight::render::render_with;
+use airlight::render::render;
 use airlight::sampling::Sampler;
 use glam::DVec3;
 
@@ -82,7 +83,7 @@ impl Fog {
 
 fn march(scene: &Scene, ray: &Ray, steps: u32, jitter: bool) -> f64 {
     let mut sampler = Sampler::for_pixel(1, 2, 3);
-    Raymarch { steps, jitter }.radiance(scene, ray, &mut sampler).x as f64
+    Raymarch::new(RaymarchOptions { steps, jitter }).radiance(scene, ray, &mut sampler).x as f64
 }
 
 #[test]
@@ -136,7 +137,9 @@ fn jittered_march_is_unbiased_around_the_integral() {
     let n = 20_000;
     let mean: f64 = (0..n)
         .map(|_| {
-            Raymarch { steps: 8, jitter: true }.radiance(&scene, &Ray::new(Vec3::ZERO, dir), &mut sampler).x as f64
+            Raymarch::new(RaymarchOptions { steps: 8, jitter: true })
+                .radiance(&scene, &Ray::new(Vec3::ZERO, dir), &mut sampler)
+                .x as f64
         })
         .sum::<f64>()
         / n as f64;
@@ -161,9 +164,9 @@ fn vacuum_medium_gives_exactly_the_direct_image() {
         }
         b.build().unwrap()
     };
-    let direct = render_with(&build(None), &Direct, &RenderObserver::none());
+    let direct = render(&build(None), &Direct, &RenderObserver::none());
     let vacuum = build(Some(Medium::homogeneous(Rgb::ZERO, Rgb::ZERO, 0.0)));
-    let marched = render_with(&vacuum, &Raymarch { steps: 16, jitter: true }, &RenderObserver::none());
+    let marched = render(&vacuum, &Raymarch::new(RaymarchOptions { steps: 16, jitter: true }), &RenderObserver::none());
     let diff = direct.pixels.iter().zip(&marched.pixels).position(|(a, b)| a != b);
     assert!(
         diff.is_none(),
@@ -221,7 +224,10 @@ fn a_sphere_casts_a_shadow_cone_of_the_right_depth() {
         let mut sampler = Sampler::for_pixel(3, 3, 3);
         let ray = Ray::new(o.as_vec3(), d.as_vec3());
         (0..64)
-            .map(|_| Raymarch { steps: 4096, jitter: true }.radiance(&scene, &ray, &mut sampler).x as f64)
+            .map(|_| {
+                Raymarch::new(RaymarchOptions { steps: 4096, jitter: true }).radiance(&scene, &ray, &mut sampler).x
+                    as f64
+            })
             .sum::<f64>()
             / 64.0
     };

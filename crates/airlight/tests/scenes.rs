@@ -1,7 +1,6 @@
 //! Every example scene in scenes/ loads and renders (small, few samples).
 
 use airlight::prelude::*;
-use airlight::render::try_render;
 
 #[test]
 fn every_example_scene_renders() {
@@ -12,10 +11,12 @@ fn every_example_scene_renders() {
         if path.extension().and_then(|e| e.to_str()) != Some("toml") {
             continue;
         }
-        let mut scene = airlight::scene::load(&path).unwrap_or_else(|e| panic!("{e}"));
-        let s = &mut scene.settings;
-        (s.width, s.height, s.spp, s.steps) = (40, 30, 1, 16);
-        let image = try_render(&scene, &RenderObserver::none()).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        let SceneFile { mut scene, mut integrator } = SceneFile::load(&path).unwrap_or_else(|e| panic!("{e}"));
+        let s = scene.settings_mut();
+        (s.width, s.height, s.spp) = (40, 30, 1);
+        integrator.raymarch.steps = 16;
+        let integrator = integrator.build(&scene).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        let image = airlight::render(&scene, integrator.as_ref(), &RenderObserver::none());
         let mean = image.mean();
         assert!(mean.is_finite() && mean.max_element() > 0.0, "{}: mean {mean}", path.display());
         count += 1;

@@ -1,11 +1,11 @@
 //! Scene files with SDF objects, volume lights and the stochastic settings:
 //! what they build, and the errors bad ones give (line and column).
 
+use airlight::SceneFile;
 use airlight::geometry::{Ray, Sdf, Shape};
 use airlight::integrator::{IntegratorKind, Sampling};
 use airlight::light::{Light, LightVolume};
 use airlight::prelude::*;
-use airlight::scene::from_toml_str;
 
 const HEAD: &str = r#"
 [render]
@@ -47,18 +47,18 @@ radius = 0.5
 intensity = [1, 2, 3]
 "#
     );
-    let scene = from_toml_str(&text, None).unwrap();
-    assert_eq!(scene.settings.integrator, IntegratorKind::Stochastic);
-    assert_eq!(scene.settings.sampling, Sampling::Mis);
-    assert!(!scene.settings.stratify);
+    let SceneFile { scene, integrator } = SceneFile::from_toml_str(&text, None).unwrap();
+    assert_eq!(integrator.kind, IntegratorKind::Stochastic);
+    assert_eq!(integrator.stochastic.sampling, Sampling::Mis);
+    assert!(!integrator.stochastic.stratify);
     assert_eq!(
-        scene.lights[0],
+        scene.lights()[0],
         Light::Volume {
             shape: LightVolume::Box { min: vec3(-1.0, 3.0, -1.0), max: vec3(1.0, 4.0, 1.0) },
             intensity: Rgb::splat(5.0)
         }
     );
-    assert_eq!(scene.lights[1], Light::volume_sphere(vec3(0.0, 2.0, 0.0), 0.5, Rgb::new(1.0, 2.0, 3.0)));
+    assert_eq!(scene.lights()[1], Light::volume_sphere(vec3(0.0, 2.0, 0.0), 0.5, Rgb::new(1.0, 2.0, 3.0)));
     // The same field built in Rust: every ray hits both at the same place.
     let sdf = Sdf::SmoothUnion {
         children: vec![
@@ -78,8 +78,8 @@ intensity = [1, 2, 3]
     for i in 0..200 {
         let (x, y) = ((i % 20) as f32 * 0.15 - 1.5, (i / 20) as f32 * 0.2 - 0.2);
         let ray = Ray::new(vec3(x, y, 0.0), Vec3::Z);
-        let a = scene.geometry.intersect(&ray, f32::INFINITY).map(|h| h.t);
-        let b = built.geometry.intersect(&ray, f32::INFINITY).map(|h| h.t);
+        let a = scene.geometry().intersect(&ray, f32::INFINITY).map(|h| h.t);
+        let b = built.geometry().intersect(&ray, f32::INFINITY).map(|h| h.t);
         assert_eq!(a, b);
         if let Some(t) = a {
             hits += 1;
@@ -92,11 +92,12 @@ intensity = [1, 2, 3]
 #[test]
 fn the_isometric_scene_renders_its_fog() {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/sdf_isometric.toml");
-    let mut scene = airlight::scene::load(&path).unwrap();
-    assert_eq!(scene.settings.integrator, IntegratorKind::Stochastic);
-    assert!(matches!(scene.lights[0], Light::Volume { shape: LightVolume::Box { .. }, .. }));
-    (scene.settings.width, scene.settings.height, scene.settings.spp) = (32, 24, 4);
-    let image = airlight::render(&scene, &RenderObserver::none());
+    let SceneFile { mut scene, integrator } = SceneFile::load(&path).unwrap();
+    assert_eq!(integrator.kind, IntegratorKind::Stochastic);
+    assert!(matches!(scene.lights()[0], Light::Volume { shape: LightVolume::Box { .. }, .. }));
+    let s = scene.settings_mut();
+    (s.width, s.height, s.spp) = (32, 24, 4);
+    let image = airlight::render(&scene, integrator.build(&scene).unwrap().as_ref(), &RenderObserver::none());
     // Every pixel sees the floor or a block through lit fog.
     assert!(image.pixels.iter().all(|p| p.min_element() > 0.0 && p.is_finite()));
 }
@@ -162,12 +163,12 @@ fn bad_cases() -> Vec<(&'static str, usize, &'static str)> {
 fn bad_sdf_and_light_tables_name_line_and_column() {
     // The render table has `sampling` at line 4: a bad value is caught there too.
     let bad_sampling = HEAD.replace("\"mis\"", "\"importance\"");
-    let e = from_toml_str(&bad_sampling, None).unwrap_err();
+    let e = SceneFile::from_toml_str(&bad_sampling, None).unwrap_err();
     assert_eq!(e.location.map(|l| l.0), Some(4), "{e}");
-    assert!(e.message.contains("unknown variant `importance`"), "{e}");
+    assert!(e.message.contains("unknown sampling `importance`"), "{e}");
     for (tables, line, phrase) in bad_cases() {
         let text = format!("{HEAD}\n{tables}");
-        let e = match from_toml_str(&text, None) {
+        let e = match SceneFile::from_toml_str(&text, None) {
             Ok(_) => panic!("accepted:\n{text}"),
             Err(e) => e,
         };
@@ -182,7 +183,7 @@ fn inline_child_errors_point_at_the_field() {
         "{HEAD}\n{}",
         "[[objects]]\ntype = \"sdf\"\nmaterial = \"m\"\nshape = \"union\"\nchildren = [{ shape = \"capsule\", a = [0, 0, 0], b = [0, 1, 0], radius = -1 }]\n"
     );
-    let e = from_toml_str(&text, None).unwrap_err();
+    let e = SceneFile::from_toml_str(&text, None).unwrap_err();
     let line = text.lines().nth(e.location.unwrap().0 - 1).unwrap();
     let col = e.location.unwrap().1;
     assert!(line[col - 1..].starts_with("-1"), "{e}: column {col} of `{line}`");

@@ -3,13 +3,12 @@
 //! solution when the lights moved, and renders more samples into a running
 //! mean, starting over whenever anything changed.
 
-use airlight::film::Image;
-use airlight::integrator::{Integrator, Raymarch, Stochastic};
-use airlight::preview::{FirstSample, Preview, set_lights};
+use airlight::film::{Accumulator, Image};
+use airlight::integrator::{Integrator, IntegratorDesc, IntegratorKind};
+use airlight::preview::{FirstSample, Preview};
 use airlight::radiosity::Radiosity;
-use airlight::render::{RenderObserver, render_samples};
-use airlight::{Camera, Scene, light::Light};
-use glam::DVec3;
+use airlight::render::{RenderObserver, accumulate};
+use airlight::{Camera, Scene, SceneFile, light::Light};
 use std::time::{Duration, Instant};
 
 /// The integrators the number keys pick.
@@ -66,6 +65,8 @@ impl FrameStats {
 /// rendered since the last change.
 pub struct Engine {
     pub scene: Scene,
+    /// The scene file's integrator options (steps, sampling, bounces, …).
+    pub integrators: IntegratorDesc,
     solution: Option<Radiosity>,
     /// Why there is no solution, when there is none.
     pub solution_note: Option<String>,
@@ -76,7 +77,7 @@ pub struct Engine {
     pub batch: u32,
     /// Accumulation stops here.
     pub max_spp: u32,
-    sum: Vec<DVec3>,
+    accumulator: Accumulator,
     samples: u32,
     lights_dirty: bool,
     /// The preview's first sample, kept while the camera stands still.
@@ -87,15 +88,17 @@ impl Engine {
     /// Compiles the scene's radiosity (the costly step: once) and renders at
     /// `width`×`height`. A scene that cannot be compiled (too many patches)
     /// is still viewed, without indirect light; `solution_note` says why.
-    pub fn new(mut scene: Scene, width: u32, height: u32, mode: Mode) -> Engine {
-        (scene.settings.width, scene.settings.height) = (width, height);
-        let (solution, solution_note) = match Radiosity::compile(&scene) {
+    pub fn new(file: SceneFile, width: u32, height: u32, mode: Mode) -> Engine {
+        let SceneFile { mut scene, integrator: integrators } = file;
+        (scene.settings_mut().width, scene.settings_mut().height) = (width, height);
+        let (solution, solution_note) = match Radiosity::compile(&scene, &integrators.radiosity) {
             Ok(s) => (Some(s), None),
             Err(e) => (None, Some(format!("no indirect light: {e}"))),
         };
         Engine {
             first: FirstSample::new(&scene),
             scene,
+            integrators,
             solution,
             solution_note,
             mode,
@@ -103,7 +106,7 @@ impl Engine {
             scale: 1,
             batch: 4,
             max_spp: 1024,
-            sum: Vec::new(),
+            accumulator: Accumulator::new(width, height),
             samples: 0,
             lights_dirty: false,
         }
@@ -124,7 +127,7 @@ impl Engine {
 
     /// The size frames are rendered at now.
     pub fn size(&self) -> (u32, u32) {
-        (self.scene.settings.width, self.scene.settings.height)
+        (self.scene.settings().width, self.scene.settings().height)
     }
 
     pub fn full_size(&self) -> (u32, u32) {
@@ -133,7 +136,8 @@ impl Engine {
 
     fn restart(&mut self) {
         self.samples = 0;
-        self.sum.clear();
+        let (w, h) = self.size();
+        self.accumulator = Accumulator::new(w, h);
     }
 
     pub fn set_mode(&mut self, mode: Mode) {
@@ -144,16 +148,16 @@ impl Engine {
     }
 
     pub fn set_camera(&mut self, camera: Camera) {
-        if camera != self.scene.camera {
-            self.scene.camera = camera;
+        if camera != *self.scene.camera() {
+            self.scene.set_camera(camera);
             self.restart();
         }
     }
 
     /// Moves the lights (same number and order as the scene's).
     pub fn set_lights(&mut self, lights: &[Light]) {
-        if lights != self.scene.lights.as_slice() {
-            set_lights(&mut self.scene, lights);
+        if lights != self.scene.lights() {
+            self.scene.set_lights(lights);
             self.lights_dirty = true;
             self.restart();
         }
@@ -165,7 +169,7 @@ impl Engine {
         let scale = scale.max(1);
         if scale != self.scale {
             self.scale = scale;
-            let s = &mut self.scene.settings;
+            let s = self.scene.settings_mut();
             s.width = (self.full.0 / scale).max(1);
             s.height = (self.full.1 / scale).max(1);
             self.restart();
@@ -184,33 +188,48 @@ impl Engine {
             && let Some(solution) = &mut self.solution
         {
             let t = Instant::now();
-            solution.update_with(&self.scene, &self.scene.lights, self.scene.settings.bounces);
+            solution.update(&self.scene, self.integrators.radiosity.bounces);
             stats.radiosity = t.elapsed();
             self.lights_dirty = false;
         }
         let count = self.samples.max(1).min(self.batch.max(1)).min(self.max_spp.saturating_sub(self.samples));
         if count > 0 {
             let t = Instant::now();
-            let s = &self.scene.settings;
-            let image = match self.mode {
+            let pass = match self.mode {
                 Mode::Preview => {
-                    let preview = Preview::new(&self.scene, self.solution.as_ref());
+                    let preview = Preview::new(
+                        &self.scene,
+                        self.solution.as_ref(),
+                        self.integrators.analytic,
+                        self.integrators.raymarch,
+                    );
                     if self.samples == 0 && count == 1 {
-                        // The same image as rendering sample 0, from
-                        // hits kept while the camera stands still.
-                        self.first.render(&self.scene, self.solution.as_ref(), &preview)
+                        // The same samples as rendering sample 0, from hits
+                        // kept while the camera stands still.
+                        let image = self.first.render(&self.scene, self.solution.as_ref(), &preview);
+                        let mut pass = Accumulator::new(image.width, image.height);
+                        for (sum, p) in pass.pixels_mut().iter_mut().zip(&image.pixels) {
+                            sum.add(*p);
+                        }
+                        pass
                     } else {
-                        self.render(&preview, count)
+                        self.accumulate(&preview, count)
                     }
                 }
-                Mode::Raymarch => self.render(&Raymarch { steps: s.steps, jitter: true }, count),
-                Mode::Stochastic => self.render(&Stochastic { sampling: s.sampling, stratify: s.stratify }, count),
+                Mode::Raymarch | Mode::Stochastic => {
+                    let kind =
+                        if self.mode == Mode::Raymarch { IntegratorKind::Raymarch } else { IntegratorKind::Stochastic };
+                    // Progressive refinement wants jittered march samples.
+                    let mut desc = self.integrators.with_kind(kind);
+                    desc.raymarch.jitter = true;
+                    match desc.build(&self.scene) {
+                        Ok(integrator) => self.accumulate(integrator.as_ref(), count),
+                        Err(_) => Accumulator::new(self.size().0, self.size().1),
+                    }
+                }
             };
-            if self.sum.len() != image.pixels.len() {
-                self.sum = vec![DVec3::ZERO; image.pixels.len()];
-            }
-            for (acc, p) in self.sum.iter_mut().zip(&image.pixels) {
-                *acc += p.as_dvec3() * count as f64;
+            if self.accumulator.merge(&pass).is_err() {
+                self.accumulator = pass;
             }
             self.samples += count;
             stats.image = t.elapsed();
@@ -220,20 +239,20 @@ impl Engine {
         stats
     }
 
-    fn render(&self, integrator: &dyn Integrator, count: u32) -> Image {
-        render_samples(&self.scene, integrator, self.samples as u64, count, &RenderObserver::none())
+    /// The preview integrator for the scene's current lights.
+    pub fn preview(&self) -> Preview<'_> {
+        Preview::new(&self.scene, self.solution.as_ref(), self.integrators.analytic, self.integrators.raymarch)
+    }
+
+    fn accumulate(&self, integrator: &dyn Integrator, count: u32) -> Accumulator {
+        let (first, rows) = (self.samples as u64, 0..self.size().1);
+        accumulate(&self.scene, integrator, first..first + count as u64, rows, &RenderObserver::none())
     }
 
     /// The running mean at the current render size (black before the
     /// first frame).
     pub fn image(&self) -> Image {
-        let (w, h) = self.size();
-        let n = self.samples.max(1) as f64;
-        let mut image = Image::new(w, h);
-        for (p, s) in image.pixels.iter_mut().zip(&self.sum) {
-            *p = (*s / n).as_vec3();
-        }
-        image
+        self.accumulator.image()
     }
 
     #[cfg(test)]
@@ -250,8 +269,8 @@ mod tests {
     use airlight::prelude::*;
 
     fn engine() -> Engine {
-        let scene = airlight::scene::from_toml_str(super::super::DEFAULT_SCENE, None).unwrap();
-        let mut e = Engine::new(scene, 32, 18, Mode::Preview);
+        let file = SceneFile::from_toml_str(super::super::DEFAULT_SCENE, None).unwrap();
+        let mut e = Engine::new(file, 32, 18, Mode::Preview);
         e.batch = 4;
         e
     }
@@ -272,14 +291,13 @@ mod tests {
             e.frame();
         }
         assert_eq!(e.samples(), 8);
-        let mut scene = airlight::scene::from_toml_str(super::super::DEFAULT_SCENE, None).unwrap();
-        (scene.settings.width, scene.settings.height, scene.settings.spp) = (32, 18, 8);
-        let preview = Preview::new(&scene, e.solution());
-        let once = airlight::render::render_with(&scene, &preview, &RenderObserver::none());
-        let mean = e.image();
-        for (a, b) in mean.pixels.iter().zip(&once.pixels) {
-            assert!((*a - *b).abs().max_element() <= 1e-5 * b.max_element().max(1.0), "{a} vs {b}");
-        }
+        let mut scene = SceneFile::from_toml_str(super::super::DEFAULT_SCENE, None).unwrap().scene;
+        let s = scene.settings_mut();
+        (s.width, s.height, s.spp) = (32, 18, 8);
+        let preview = e.preview();
+        let once = airlight::render(&scene, &preview, &RenderObserver::none());
+        // One accumulator under both: the same bits.
+        assert_eq!(e.image(), once);
     }
 
     #[test]
@@ -287,7 +305,7 @@ mod tests {
         let mut e = engine();
         e.frame();
         e.frame();
-        let same = e.scene.lights.clone();
+        let same = e.scene.lights().to_vec();
         e.set_lights(&same);
         assert_eq!(e.samples(), 2);
         assert!(!e.lights_pending());

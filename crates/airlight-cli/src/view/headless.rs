@@ -41,11 +41,11 @@ pub fn run(engine: &mut Engine, script: &Script, start: &Start, frames: u32, out
         stats.push(s);
         if let Some(dir) = out {
             let image = engine.image();
-            let settings = &engine.scene.settings;
+            let settings = engine.scene.settings();
             for ext in ["exr", "png"] {
                 let file = dir.join(format!("frame_{k:04}.{ext}"));
                 image
-                    .write(&file, settings.exposure, settings.tonemap)
+                    .save_with(&file, settings.exposure, settings.tonemap)
                     .map_err(|e| format!("cannot write `{}`: {e}", file.display()))?;
             }
         }
@@ -71,7 +71,7 @@ pub fn describe(engine: &Engine) -> String {
     if mode != super::engine::Mode::Preview {
         return mode.name().to_string();
     }
-    let glow = airlight::preview::Preview::new(&engine.scene, None).glow_name();
+    let glow = engine.preview().glow_name();
     let indirect = if engine.solution().is_some() { "radiosity indirect" } else { "no indirect" };
     format!("preview (direct + {indirect} + glow: {glow})")
 }

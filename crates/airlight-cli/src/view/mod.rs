@@ -74,21 +74,22 @@ pub struct ViewArgs {
 }
 
 pub fn run(args: ViewArgs) -> Result<(), String> {
-    let (scene, name) = match &args.scene {
-        Some(p) => (airlight::scene::load(p).map_err(|e| e.to_string())?, p.display().to_string()),
+    let (file, name) = match &args.scene {
+        Some(p) => (crate::load(Some(p))?, p.display().to_string()),
         None => (
-            airlight::scene::from_toml_str(DEFAULT_SCENE, None).map_err(|e| format!("built-in scene: {e}"))?,
+            airlight::SceneFile::from_toml_str(DEFAULT_SCENE, None).map_err(|e| format!("built-in scene: {e}"))?,
             "the built-in Cornell box".to_string(),
         ),
     };
+    let scene = &file.scene;
     if !(args.period.is_finite() && args.period > 0.0) {
         return Err(format!("--period must be a positive number of seconds, got {}", args.period));
     }
     let script = match &args.path {
-        Some(p) => path::load(p, &scene).map_err(|e| e.to_string())?,
+        Some(p) => path::load(p, scene).map_err(|e| e.to_string())?,
         None => Script::scene_keyframes(),
     };
-    let start = Start { camera: scene.camera, lights: scene.lights.clone(), paths: scene.light_paths.clone() };
+    let start = Start { camera: *scene.camera(), lights: scene.lights().to_vec(), paths: scene.light_paths().to_vec() };
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(args.threads.unwrap_or(0) as usize)
         .build()
@@ -96,7 +97,7 @@ pub fn run(args: ViewArgs) -> Result<(), String> {
     pool.install(|| {
         let mode = args.integrator.or(script.integrator).unwrap_or(Mode::Preview);
         let t = std::time::Instant::now();
-        let mut engine = Engine::new(scene, args.width, args.height, mode);
+        let mut engine = Engine::new(file, args.width, args.height, mode);
         match engine.solution() {
             Some(s) => eprintln!(
                 "{name}: radiosity compiled in {:.0} ms ({} patches)",

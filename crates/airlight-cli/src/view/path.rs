@@ -138,7 +138,7 @@ pub fn parse(text: &str, scene: &Scene) -> Result<Script, SceneError> {
             Some(v) if !(v.get_ref().is_finite() && *v.get_ref() > 0.0 && *v.get_ref() < 180.0) => {
                 return Err(at(v.span(), format!("camera.fov must be in (0, 180) degrees, got {}", v.get_ref())));
             }
-            Some(v) if matches!(scene.camera.projection, Projection::Orthographic { .. }) => {
+            Some(v) if matches!(scene.camera().projection, Projection::Orthographic { .. }) => {
                 return Err(at(
                     v.span(),
                     "camera.fov is for perspective cameras; this scene's camera is orthographic".into(),
@@ -150,15 +150,15 @@ pub fn parse(text: &str, scene: &Scene) -> Result<Script, SceneError> {
         camera.push((f, (position, look_at, fov)));
     }
 
-    let mut lights = vec![Vec::new(); scene.lights.len()];
+    let mut lights = vec![Vec::new(); scene.lights().len()];
     for key in &desc.light {
         let k = key.get_ref();
         let index = *k.light.get_ref();
-        let n = scene.lights.len();
+        let n = scene.lights().len();
         let light = usize::try_from(index).ok().filter(|&i| i < n).ok_or_else(|| {
             at(k.light.span(), format!("light = {index}: the scene has {n} lights, numbered 0 to {}", n as i64 - 1))
         })?;
-        if scene.lights[light].position().is_none() {
+        if scene.lights()[light].position().is_none() {
             return Err(at(k.light.span(), format!("light {light} is a distant light, which has no position to move")));
         }
         let keys: &mut Vec<(u32, Vec3)> = &mut lights[light];

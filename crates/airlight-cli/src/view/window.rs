@@ -11,8 +11,8 @@
 use super::engine::{Engine, Mode};
 use super::headless::Start;
 use super::input::{Controls, FlyCamera, nudge};
+use airlight::film::Tonemap;
 use airlight::film::{self, Image};
-use airlight::scene::Tonemap;
 use glam::{Vec2, Vec3};
 use minifb::{Key, KeyRepeat, MouseButton, MouseMode, Window, WindowOptions};
 use std::path::{Path, PathBuf};
@@ -37,13 +37,13 @@ pub fn run(engine: &mut Engine, start: &Start, options: &Options) -> Result<(), 
         .map_err(|e| format!("cannot open a window ({e}); without a display, use --headless"))?;
     // Caps the polling rate when idle; rendering is slower than this anyway.
     window.set_target_fps(120);
-    let mut fly = FlyCamera::from_camera(&start.camera, (0.15 * engine.scene.bounds_radius).max(0.05));
+    let mut fly = FlyCamera::from_camera(&start.camera, (0.15 * engine.scene.bounds().1).max(0.05));
     let mut lights = start.lights.clone();
     let movable: Vec<usize> = (0..lights.len()).filter(|&i| lights[i].position().is_some()).collect();
     let mut selected = 0;
     let (mut playing, mut time) = (false, 0.0f32);
     let mut buffer = vec![0u32; w * h];
-    let lut = Lut::new(engine.scene.settings.exposure, engine.scene.settings.tonemap);
+    let lut = Lut::new(engine.scene.settings().exposure, engine.scene.settings().tonemap);
     let mut last = Instant::now();
     let mut mouse_prev: Option<(f32, f32)> = None;
     let mut full_ms = 0.0;
@@ -180,14 +180,14 @@ fn show(image: &Image, buffer: &mut [u32], w: usize, h: usize, lut: &Lut) {
 /// Writes `dir/airlight-view-NNNN.exr` and `.png` with the first number not
 /// taken; each file is written whole or not at all (`Image::write`).
 fn save_image(image: &Image, engine: &Engine, dir: &Path) -> Result<String, String> {
-    let s = &engine.scene.settings;
+    let s = engine.scene.settings();
     let free = (1..10_000)
         .map(|n| dir.join(format!("airlight-view-{n:04}")))
         .find(|stem| !stem.with_extension("png").exists() && !stem.with_extension("exr").exists());
     let stem = free.ok_or_else(|| format!("no free airlight-view-NNNN name left in `{}`", dir.display()))?;
     for ext in ["exr", "png"] {
         let file = stem.with_extension(ext);
-        image.write(&file, s.exposure, s.tonemap).map_err(|e| format!("cannot write `{}`: {e}", file.display()))?;
+        image.save_with(&file, s.exposure, s.tonemap).map_err(|e| format!("cannot write `{}`: {e}", file.display()))?;
     }
     Ok(format!("{}.exr and .png", stem.display()))
 }

@@ -23,27 +23,27 @@
 mod reference;
 
 use airlight::film;
+use airlight::integrator::RaymarchOptions;
 use airlight::integrator::analytic::{Analytic, AnalyticOptions};
 use airlight::integrator::{Direct, Integrator, Raymarch};
 use airlight::prelude::*;
-use airlight::render::render_with;
+use airlight::render::render;
 use reference::Reference;
 use std::path::PathBuf;
 use std::time::Instant;
 
 fn load(name: &str, w: u32, h: u32) -> Scene {
     let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../scenes").join(name);
-    let mut scene = airlight::scene::load(&path).unwrap_or_else(|e| panic!("{e}"));
-    scene.settings.width = w;
-    scene.settings.height = h;
-    scene.settings.spp = 1;
-    scene.settings.jitter = false;
+    let mut scene = airlight::SceneFile::load(&path).unwrap_or_else(|e| panic!("{e}")).scene;
+    scene.settings_mut().width = w;
+    scene.settings_mut().height = h;
+    scene.settings_mut().spp = 1;
     scene
 }
 
 fn timed(scene: &Scene, integrator: &dyn Integrator) -> (Image, f64) {
     let start = Instant::now();
-    let image = render_with(scene, integrator, &RenderObserver::none());
+    let image = render(scene, integrator, &RenderObserver::none());
     (image, start.elapsed().as_secs_f64())
 }
 
@@ -89,7 +89,7 @@ fn main() {
     println!("threads: {}, {}×{}, 1 spp, reference tol {:e}", rayon::current_num_threads(), a.w, a.h, a.tol);
     for (name, shadows) in [("glow.toml", false), ("shadow_spheres.toml", true)] {
         let scene = load(name, a.w, a.h);
-        let options = AnalyticOptions { shadows, ..AnalyticOptions::from_settings(&scene.settings) };
+        let options = AnalyticOptions { shadows, ..AnalyticOptions::default() };
         let analytic = Analytic::new(&scene, options).unwrap();
         println!("\n## {name}, shadows = {shadows}");
 
@@ -97,7 +97,7 @@ fn main() {
         let small = load(name, 160, 120);
         let (r1, _) = timed(&small, &Reference { tol: a.tol });
         let (r2, _) = timed(&small, &Reference { tol: a.tol / 10.0 });
-        let (jm, _) = timed(&small, &Raymarch { steps: 4096, jitter: true });
+        let (jm, _) = timed(&small, &Raymarch::new(RaymarchOptions { steps: 4096, jitter: true }));
         println!(
             "reference at 160×120: vs itself at tol/10: rel_rmse {:.2e}; vs raymarch 4096 jittered: {:.2e}",
             err(&r1, &r2),
@@ -122,7 +122,7 @@ fn main() {
         println!("| raymarch steps | time (s) | rel_rmse | time / analytic |");
         println!("|---:|---:|---:|---:|");
         let run = |steps: u32| {
-            let (im, t) = timed(&scene, &Raymarch { steps, jitter: false });
+            let (im, t) = timed(&scene, &Raymarch::new(RaymarchOptions { steps, jitter: false }));
             let e = err(&im, &reference);
             println!("| {steps} | {t:.3} | {e:.4} | {:.1}× |", t / best);
             (e, t)

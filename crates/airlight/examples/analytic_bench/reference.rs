@@ -7,7 +7,7 @@
 //!
 //! r the distance to the (point) light and V its visibility by a shadow ray
 //! through the scene's BVH (as `raymarch` casts them). The surface term is
-//! the one every integrator shares (`surface_radiance`, attenuated by
+//! the one every integrator shares (`single_scattering, no_extra`, attenuated by
 //! e^{−σt t_end}). No sampling: the same camera ray as the other
 //! integrators (1 spp, same seed), integrated to a relative tolerance.
 //!
@@ -20,7 +20,7 @@
 
 use airlight::Rgb;
 use airlight::geometry::Ray;
-use airlight::integrator::{Integrator, surface_radiance};
+use airlight::integrator::{Integrator, no_extra, single_scattering};
 use airlight::light::Light;
 use airlight::medium::henyey_greenstein;
 use airlight::sampling::Sampler;
@@ -96,11 +96,11 @@ struct PointSource {
 
 impl Reference {
     fn in_scattered(&self, scene: &Scene, ray: &Ray, t_end: f64) -> DVec3 {
-        let medium = scene.medium.as_ref().unwrap();
+        let medium = scene.medium().unwrap();
         let sigma_t = medium.sigma_t().as_dvec3();
         let sigma_s = medium.sigma_s.as_dvec3();
         let lights: Vec<PointSource> = scene
-            .lights
+            .lights()
             .iter()
             .map(|l| match *l {
                 Light::Point { position, intensity, .. } => {
@@ -119,7 +119,7 @@ impl Reference {
                 let r = r2.sqrt();
                 let wi = to / r;
                 let (xf, wf) = (x.as_vec3(), wi.as_vec3());
-                if scene.geometry.occluded(xf, wf, (r * (1.0 - 1e-4)) as f32) {
+                if scene.geometry().occluded(xf, wf, (r * (1.0 - 1e-4)) as f32) {
                     continue;
                 }
                 let phase = henyey_greenstein((-d).dot(wi) as f32, medium.g) as f64;
@@ -167,21 +167,8 @@ impl Reference {
 
 impl Integrator for Reference {
     fn radiance(&self, scene: &Scene, ray: &Ray, sampler: &mut Sampler) -> Rgb {
-        let hit = scene.geometry.intersect(ray, f32::INFINITY);
-        let medium = scene.medium.as_ref();
-        let (surface, t_end) = match hit {
-            Some(hit) => {
-                let s = scene.geometry.surface(ray, hit);
-                (surface_radiance(scene, ray, &s, sampler, medium), hit.t)
-            }
-            None => (scene.settings.background, scene.settings.max_distance),
-        };
-        let Some(m) = medium else { return surface };
-        let through = m.transmittance(ray.origin, ray.dir, 0.0, t_end);
-        let end = t_end.min(scene.settings.max_distance) as f64;
-        if end <= 0.0 {
-            return surface * through;
-        }
-        surface * through + self.in_scattered(scene, ray, end).as_vec3()
+        single_scattering(scene, ray, sampler, no_extra, |_, length, _| {
+            if length <= 0.0 { Rgb::ZERO } else { self.in_scattered(scene, ray, length as f64).as_vec3() }
+        })
     }
 }

@@ -1,20 +1,14 @@
-use super::{Integrator, surface_radiance};
+use super::{Integrator, first_surface, no_extra};
 use crate::Rgb;
 use crate::geometry::Ray;
 use crate::sampling::Sampler;
 use crate::scene::Scene;
 
-/// Direct illumination of surfaces with shadows, in vacuum.
+/// Direct illumination of surfaces with shadows; any medium is ignored.
 pub struct Direct;
 
 impl Integrator for Direct {
     fn radiance(&self, scene: &Scene, ray: &Ray, sampler: &mut Sampler) -> Rgb {
-        match scene.geometry.intersect(ray, f32::INFINITY) {
-            Some(hit) => {
-                let surface = scene.geometry.surface(ray, hit);
-                surface_radiance(scene, ray, &surface, sampler, None)
-            }
-            None => scene.settings.background,
-        }
+        first_surface(scene, ray, sampler, None, no_extra).0
     }
 }

@@ -1,31 +1,38 @@
 //! Integrators: each turns a camera ray into the radiance arriving along it.
-//! They share one trait; the scene's `[render] integrator` picks one.
+//! They share one trait and are built from their own options by one
+//! function ([`IntegratorDesc::build`]); a scene file's `[render]
+//! integrator` picks one.
 
 pub mod analytic;
 mod direct;
 pub mod equiangular;
+mod options;
 pub mod path;
 mod radiosity;
 mod raymarch;
 mod stochastic;
 
-pub use analytic::Analytic;
+pub use analytic::{Analytic, AnalyticOptions};
 pub use direct::Direct;
 pub use equiangular::Equiangular;
+pub use options::{
+    DEFAULT_LINK_THRESHOLD, IntegratorDesc, IntegratorError, MAX_BOUNCES, MAX_DEPTH, MAX_LIGHT_STEPS, MAX_STEPS,
+    OptionError, PathOptions, RadiosityOptions, RaymarchOptions, StochasticOptions,
+};
 pub use path::PathTracer;
-pub use radiosity::RadiosityIntegrator;
-pub use raymarch::{Raymarch, in_scattered};
+pub use radiosity::{RadiosityIntegrator, indirect_radiance};
+pub use raymarch::{Raymarch, in_scattered, march};
 pub use stochastic::{Sampling, Stochastic};
 
 use crate::Rgb;
-use crate::geometry::{Ray, SurfaceHit, offset_origin};
+use crate::geometry::{Ray, SurfaceHit};
 use crate::medium::Medium;
 use crate::sampling::{Sampler, keyed2};
-use crate::scene::Scene;
-use serde::Deserialize;
+use crate::scene::{Scene, light_numbers};
 
-/// Estimates radiance along camera rays. Implementations hold only settings;
-/// all per-ray state lives on the stack, so one instance serves all threads.
+/// Estimates radiance along camera rays. Implementations hold settings and
+/// what they derive from the scene; all per-ray state lives on the stack, so
+/// one instance serves all threads.
 pub trait Integrator: Send + Sync {
     /// Radiance arriving at the camera along `ray` (one sample).
     fn radiance(&self, scene: &Scene, ray: &Ray, sampler: &mut Sampler) -> Rgb;
@@ -36,11 +43,19 @@ pub trait Integrator: Send + Sync {
     fn stratified(&self) -> bool {
         false
     }
+
+    /// The scene's lights changed ([`Scene::set_lights`], [`Scene::at_time`]):
+    /// update what was derived from them (radiosity relights its patches
+    /// without recompiling; the analytic integrator re-places its emitters).
+    /// Nothing by default.
+    fn lights_changed(&mut self, scene: &Scene) -> Result<(), IntegratorError> {
+        let _ = scene;
+        Ok(())
+    }
 }
 
 /// The integrators a scene or the command line can name.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Deserialize)]
-#[serde(rename_all = "lowercase")]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum IntegratorKind {
     /// Direct light on surfaces with shadows; any medium is ignored.
     Direct,
@@ -94,17 +109,69 @@ impl std::fmt::Display for IntegratorKind {
     }
 }
 
-/// The integrator a scene asks for, or why it cannot be had.
-pub fn for_scene(scene: &Scene) -> Result<Box<dyn Integrator>, String> {
-    let s = &scene.settings;
-    match s.integrator {
-        IntegratorKind::Direct => Ok(Box::new(Direct)),
-        IntegratorKind::Raymarch => Ok(Box::new(Raymarch { steps: s.steps, jitter: s.jitter })),
-        IntegratorKind::Path => Ok(Box::new(PathTracer::new(s.max_depth))),
-        IntegratorKind::Radiosity => Ok(Box::new(RadiosityIntegrator::new(scene).map_err(|e| e.to_string())?)),
-        IntegratorKind::Analytic => Ok(Box::new(Analytic::new(scene, analytic::AnalyticOptions::from_settings(s))?)),
-        IntegratorKind::Stochastic => Ok(Box::new(Stochastic { sampling: s.sampling, stratify: s.stratify })),
+/// Radiance along `ray` as every single-scattering integrator sees it: the
+/// first surface (its emission and direct light, plus `extra`, e.g. the
+/// indirect light of a radiosity solution), attenuated by the scene's medium
+/// all the way to it, plus `in_scattered(medium, length, sampler)`, the
+/// light the medium scatters toward the ray's origin over [0, length]. The
+/// medium is integrated to the surface or to `max_distance`, whichever is
+/// nearer; a ray that hits nothing sees the background from `max_distance`.
+/// Without a medium this is the surface alone. The surface is evaluated
+/// first, so the samples it draws (and so, in vacuum, the image) are those
+/// of the `direct` integrator.
+pub fn single_scattering(
+    scene: &Scene,
+    ray: &Ray,
+    sampler: &mut Sampler,
+    extra: impl FnOnce(&SurfaceHit) -> Rgb,
+    in_scattered: impl FnOnce(&Medium, f32, &mut Sampler) -> Rgb,
+) -> Rgb {
+    let (surface, t_end) = first_surface(scene, ray, sampler, scene.medium(), extra);
+    through_medium(scene, ray, surface, t_end, sampler, in_scattered)
+}
+
+/// The second half of [`single_scattering`]: `surface` radiance from
+/// distance `t_end` along `ray`, attenuated by the scene's medium, plus the
+/// light the medium scatters in front of it (up to `max_distance`).
+pub fn through_medium(
+    scene: &Scene,
+    ray: &Ray,
+    surface: Rgb,
+    t_end: f32,
+    sampler: &mut Sampler,
+    in_scattered: impl FnOnce(&Medium, f32, &mut Sampler) -> Rgb,
+) -> Rgb {
+    let Some(medium) = scene.medium() else {
+        return surface;
+    };
+    let through = medium.transmittance(ray.origin, ray.dir, 0.0, t_end);
+    let length = t_end.min(scene.settings().max_distance);
+    surface * through + in_scattered(medium, length, sampler)
+}
+
+/// The radiance leaving the first surface along `ray` toward its origin
+/// (emission, direct light attenuated by `medium` on its way, plus
+/// `extra`), and its distance; the background and `max_distance` when
+/// nothing is hit.
+pub fn first_surface(
+    scene: &Scene,
+    ray: &Ray,
+    sampler: &mut Sampler,
+    medium: Option<&Medium>,
+    extra: impl FnOnce(&SurfaceHit) -> Rgb,
+) -> (Rgb, f32) {
+    match scene.geometry().intersect(ray, f32::INFINITY) {
+        Some(hit) => {
+            let s = scene.geometry().surface(ray, hit);
+            (surface_radiance(scene, ray, &s, sampler, medium) + extra(&s), hit.t)
+        }
+        None => (scene.settings().background, scene.settings().max_distance),
     }
+}
+
+/// No extra surface term.
+pub fn no_extra(_: &SurfaceHit) -> Rgb {
+    Rgb::ZERO
 }
 
 /// Radiance leaving a surface toward `-ray.dir`: its emission plus direct
@@ -119,29 +186,26 @@ pub fn surface_radiance(
 ) -> Rgb {
     let wo = -ray.dir;
     let mut radiance = match surface.emitter {
-        Some(light) => scene.lights[light as usize].emitted(surface.n, ray.dir),
+        Some(light) => scene.lights()[light as usize].emitted(surface.n, ray.dir),
         None => Rgb::ZERO,
     };
-    let material = &scene.materials[surface.material as usize];
+    let material = scene.material_at(surface);
     let key = sampler.next_key();
-    scene.for_each_light_at(surface.p, |index, light| {
-        let Some(sample) = light.sample(surface.p, keyed2(key, index as u64)) else { return };
+    scene.for_each_light_at(surface.p, |index, _| {
+        let u = light_numbers(keyed2(key, index as u64));
+        let Some(sample) = scene.sample_light(index, surface.p, u) else { return };
         let cos = sample.wi.dot(surface.n).abs();
-        if cos == 0.0 || sample.weight == Rgb::ZERO {
+        if cos == 0.0 {
             return;
         }
         let f = material.brdf(surface.p, surface.n, wo, sample.wi);
-        if f == Rgb::ZERO {
-            return;
-        }
-        let origin = offset_origin(surface.p, surface.n, sample.wi);
-        let distance = scene.light_distance(sample.distance);
-        if !scene.light_visible(surface.p, origin, sample.wi, sample.distance) {
+        if f == Rgb::ZERO || !scene.unoccluded(surface.p, Some(surface.n), &sample) {
             return;
         }
         let mut contribution = f * sample.weight * cos;
         if let Some(m) = medium {
-            contribution *= m.transmittance(origin, sample.wi, 0.0, distance);
+            let origin = crate::geometry::offset_origin(surface.p, surface.n, sample.wi);
+            contribution *= m.transmittance(origin, sample.wi, 0.0, scene.light_distance(sample.distance));
         }
         radiance += contribution;
     });

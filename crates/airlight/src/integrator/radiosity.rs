@@ -1,11 +1,11 @@
 //! The `radiosity` integrator: direct light per pixel, indirect light from
-//! the patches (the seed's "different frequencies").
+//! the patches (direct and indirect light "at different frequencies").
 
-use super::raymarch::in_scattered;
-use super::{Integrator, surface_radiance};
+use super::raymarch::march;
+use super::{Integrator, IntegratorError, RadiosityOptions, RaymarchOptions, single_scattering};
 use crate::Rgb;
-use crate::geometry::Ray;
-use crate::radiosity::{Radiosity, RadiosityError};
+use crate::geometry::{Ray, SurfaceHit};
+use crate::radiosity::{CompileParams, FrameTimes, Radiosity};
 use crate::sampling::Sampler;
 use crate::scene::Scene;
 use std::f32::consts::FRAC_1_PI;
@@ -19,54 +19,53 @@ use std::f32::consts::FRAC_1_PI;
 /// point (so a checker stays sharp) and E_ind the indirect irradiance
 /// interpolated between patch centres on the side facing the camera. In a
 /// medium, L is attenuated along the camera ray and single scattering is
-/// added as the `raymarch` integrator does (`steps`, `jitter`); the patches'
-/// indirect light is computed in vacuum.
+/// added as the `raymarch` integrator does (its `steps`, `jitter`); the
+/// patches' indirect light is computed in vacuum.
 ///
-/// The solution must have been compiled from, and updated for, the scene it
-/// renders ([`Radiosity::update`] after lights move).
+/// The solution is compiled once; when the scene's lights change,
+/// [`Integrator::lights_changed`] relights it ([`Radiosity::update`])
+/// without recompiling.
 pub struct RadiosityIntegrator {
     pub solution: Radiosity,
-    pub steps: u32,
-    pub jitter: bool,
+    pub options: RadiosityOptions,
+    pub march: RaymarchOptions,
+    /// Time spent in the last relighting.
+    pub last_update: FrameTimes,
 }
 
 impl RadiosityIntegrator {
-    /// Compiles and lights `scene` with its own settings.
-    pub fn new(scene: &Scene) -> Result<Self, RadiosityError> {
-        Ok(RadiosityIntegrator {
-            solution: Radiosity::compile(scene)?,
-            steps: scene.settings.steps,
-            jitter: scene.settings.jitter,
-        })
+    /// Compiles and lights `scene`.
+    pub fn new(scene: &Scene, options: RadiosityOptions, march: RaymarchOptions) -> Result<Self, IntegratorError> {
+        options.validate()?;
+        let mut solution = Radiosity::compile_with(scene, CompileParams::for_scene(scene, &options))?;
+        let last_update = solution.update(scene, options.bounces);
+        Ok(RadiosityIntegrator { solution, options, march, last_update })
+    }
+}
+
+/// The light a radiosity solution reflects at `s` toward a ray arriving
+/// along `dir`: ρ/π times the indirect irradiance on the side facing it.
+pub fn indirect_radiance(scene: &Scene, solution: &Radiosity, dir: glam::Vec3, s: &SurfaceHit) -> Rgb {
+    let n = if s.n.dot(dir) <= 0.0 { s.n } else { -s.n };
+    match solution.irradiance_at(s.p, n) {
+        Some(e) => scene.material_at(s).albedo(s.p, s.n) * FRAC_1_PI * e,
+        None => Rgb::ZERO,
     }
 }
 
 impl Integrator for RadiosityIntegrator {
     fn radiance(&self, scene: &Scene, ray: &Ray, sampler: &mut Sampler) -> Rgb {
-        let medium = scene.medium.as_ref();
-        let tmax = match medium {
-            Some(_) => f32::INFINITY,
-            None => scene.settings.max_distance,
-        };
-        let (surface, t_end) = match scene.geometry.intersect(ray, tmax) {
-            Some(hit) => {
-                let s = scene.geometry.surface(ray, hit);
-                let mut l = surface_radiance(scene, ray, &s, sampler, medium);
-                let n = if s.n.dot(ray.dir) <= 0.0 { s.n } else { -s.n };
-                if let Some(e) = self.solution.irradiance_at(s.p, n) {
-                    let albedo = scene.materials[s.material as usize].albedo(s.p, s.n);
-                    l += albedo * FRAC_1_PI * e;
-                }
-                (l, hit.t)
-            }
-            None => (scene.settings.background, scene.settings.max_distance),
-        };
-        let Some(medium) = medium else {
-            return surface;
-        };
-        let offset = if self.jitter { sampler.next() } else { 0.5 };
-        let through = medium.transmittance(ray.origin, ray.dir, 0.0, t_end);
-        let march_end = t_end.min(scene.settings.max_distance);
-        surface * through + in_scattered(scene, medium, ray, march_end, self.steps, offset, sampler)
+        single_scattering(
+            scene,
+            ray,
+            sampler,
+            |s| indirect_radiance(scene, &self.solution, ray.dir, s),
+            |medium, length, sampler| march(scene, medium, ray, length, self.march, sampler),
+        )
+    }
+
+    fn lights_changed(&mut self, scene: &Scene) -> Result<(), IntegratorError> {
+        self.last_update = self.solution.update(scene, self.options.bounces);
+        Ok(())
     }
 }

@@ -1,13 +1,14 @@
-//! Ray marching of a participating medium, after the seed
-//! (raymarching-participating-media.txt): trace to the nearest surface, then
+//! Ray marching of a participating medium, as in Wyman and Ramsey,
+//! "Interactive Volumetric Shadows in Participating Media with
+//! Single-Scattering" (2008): trace to the nearest surface, then
 //! sample the medium between eye and surface, a shadow ray from each sample.
 
-use super::{Integrator, surface_radiance};
+use super::{Integrator, RaymarchOptions, no_extra, single_scattering};
 use crate::Rgb;
 use crate::geometry::Ray;
 use crate::medium::Medium;
 use crate::sampling::{Sampler, keyed2};
-use crate::scene::Scene;
+use crate::scene::{Scene, light_numbers};
 use glam::DVec3;
 
 /// The ray-marching integrator.
@@ -27,34 +28,35 @@ use glam::DVec3;
 /// middle of each segment, so the linear term of S's variation cancels and
 /// what remains per segment is O(Δ³), over N = T/Δ segments.
 pub struct Raymarch {
-    pub steps: u32,
-    pub jitter: bool,
+    pub options: RaymarchOptions,
+}
+
+impl Raymarch {
+    pub fn new(options: RaymarchOptions) -> Self {
+        Raymarch { options }
+    }
 }
 
 impl Integrator for Raymarch {
     fn radiance(&self, scene: &Scene, ray: &Ray, sampler: &mut Sampler) -> Rgb {
-        // A medium that neither absorbs nor scatters is vacuum.
-        let medium = scene.medium.as_ref().filter(|m| !m.is_vacuum());
-        let hit = scene.geometry.intersect(ray, f32::INFINITY);
-        // The surface first, so that with a vacuum the samples drawn, and so
-        // the image, are exactly those of `direct`.
-        let (surface, t_end) = match hit {
-            Some(hit) => {
-                let s = scene.geometry.surface(ray, hit);
-                (surface_radiance(scene, ray, &s, sampler, medium), hit.t)
-            }
-            None => (scene.settings.background, scene.settings.max_distance),
-        };
-        let Some(medium) = medium else {
-            return surface;
-        };
-        let offset = if self.jitter { sampler.next() } else { 0.5 };
-        let through = medium.transmittance(ray.origin, ray.dir, 0.0, t_end);
-        // Marching stops at max_distance even when a surface lies beyond it
-        // (a floor seen near the horizon), so steps stay short.
-        let march_end = t_end.min(scene.settings.max_distance);
-        surface * through + in_scattered(scene, medium, ray, march_end, self.steps, offset, sampler)
+        single_scattering(scene, ray, sampler, no_extra, |medium, length, sampler| {
+            march(scene, medium, ray, length, self.options, sampler)
+        })
     }
+}
+
+/// [`in_scattered`] with the march's own offset: a random fraction of a
+/// step per pixel sample with jitter, the middle of each step without.
+pub fn march(
+    scene: &Scene,
+    medium: &Medium,
+    ray: &Ray,
+    length: f32,
+    options: RaymarchOptions,
+    sampler: &mut Sampler,
+) -> Rgb {
+    let offset = if options.jitter { sampler.next() } else { 0.5 };
+    in_scattered(scene, medium, ray, length, options.steps, offset, sampler)
 }
 
 /// Single-scattered radiance along `ray` over [0, t_end], marched with
@@ -85,13 +87,14 @@ pub fn in_scattered(
         let weight = segment_weight(tau, dt);
         let mut light_in = Rgb::ZERO;
         let key = sampler.next_key();
-        scene.for_each_light_at(p, |index, light| {
-            let Some(sample) = light.sample(p, keyed2(key, index as u64)) else { return };
-            let distance = scene.light_distance(sample.distance);
-            if !scene.light_visible(p, p, sample.wi, sample.distance) {
+        scene.for_each_light_at(p, |index, _| {
+            let u = light_numbers(keyed2(key, index as u64));
+            let Some(sample) = scene.sample_light(index, p, u) else { return };
+            if !scene.unoccluded(p, None, &sample) {
                 return;
             }
             let phase = medium.phase(wo, sample.wi);
+            let distance = scene.light_distance(sample.distance);
             light_in += sample.weight * phase * medium.transmittance(p, sample.wi, 0.0, distance);
         });
         total += to_eye * (medium.sigma_s * medium.density_at(p) * weight * light_in).as_dvec3();

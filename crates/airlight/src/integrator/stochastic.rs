@@ -1,5 +1,5 @@
-//! Monte Carlo single scattering, after the seed
-//! (monte-carlo-volumetric-light-sdf.txt): per pixel sample, a point x on the
+//! Monte Carlo single scattering, after Anders Hoff's "Volumetric Light"
+//! (inconvergent.net, "the seed" below): per pixel sample, a point x on the
 //! camera segment [eye, hit] and a point y in the light; if the path between
 //! them is clear, add the light scattered at x toward the eye.
 //!
@@ -31,17 +31,16 @@
 //! plane" facing the camera, whose radiance is `background`.
 
 use super::equiangular::Equiangular;
-use super::{Integrator, surface_radiance};
+use super::{Integrator, StochasticOptions, no_extra, single_scattering};
 use crate::Rgb;
 use crate::geometry::Ray;
+use crate::medium::Medium;
 use crate::sampling::Sampler;
 use crate::scene::Scene;
 use glam::Vec3;
-use serde::Deserialize;
 
 /// How the point on the camera segment is drawn.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default, Deserialize)]
-#[serde(rename_all = "lowercase")]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
 pub enum Sampling {
     /// Uniform in distance (the seed's estimator).
     Uniform,
@@ -87,33 +86,34 @@ pub struct Stochastic {
     pub stratify: bool,
 }
 
+impl Stochastic {
+    pub fn new(options: StochasticOptions) -> Self {
+        Stochastic { sampling: options.sampling, stratify: options.stratify }
+    }
+}
+
 impl Integrator for Stochastic {
     fn stratified(&self) -> bool {
         self.stratify
     }
 
     fn radiance(&self, scene: &Scene, ray: &Ray, sampler: &mut Sampler) -> Rgb {
-        let medium = scene.medium.as_ref().filter(|m| !m.is_vacuum());
-        let hit = scene.geometry.intersect(ray, f32::INFINITY);
-        let (surface, t_end) = match hit {
-            Some(hit) => {
-                let s = scene.geometry.surface(ray, hit);
-                (surface_radiance(scene, ray, &s, sampler, medium), hit.t)
-            }
-            None => (scene.settings.background, scene.settings.max_distance),
-        };
-        let Some(medium) = medium else {
-            return surface;
-        };
-        let through = medium.transmittance(ray.origin, ray.dir, 0.0, t_end);
-        // As in raymarch: the medium is integrated up to max_distance at most.
-        let length = t_end.min(scene.settings.max_distance);
-        let mut total = surface * through;
+        single_scattering(scene, ray, sampler, no_extra, |medium, length, sampler| {
+            self.in_scattered(scene, medium, ray, length, sampler)
+        })
+    }
+}
+
+impl Stochastic {
+    /// One sample per light of the light scattered toward the ray's origin
+    /// over [0, length].
+    fn in_scattered(&self, scene: &Scene, medium: &Medium, ray: &Ray, length: f32, sampler: &mut Sampler) -> Rgb {
+        let mut total = Rgb::ZERO;
         if medium.sigma_s == Rgb::ZERO || length <= 0.0 {
             return total;
         }
         let wo = -ray.dir;
-        for (index, light) in scene.lights.iter().enumerate() {
+        for (index, light) in scene.lights().iter().enumerate() {
             let u = if self.stratify {
                 sampler.stratified4(1 + index as u32)
             } else {
@@ -122,14 +122,11 @@ impl Integrator for Stochastic {
             let u_light = Vec3::new(u[1], u[2], u[3]);
             let Some((t, pdf)) = self.distance(ray, length, light.anchor(), u[0]) else { continue };
             let x = ray.at(t);
-            let Some(sample) = light.sample3(x, u_light) else { continue };
-            if sample.weight == Rgb::ZERO {
+            let Some(sample) = scene.sample_light(index, x, u_light) else { continue };
+            if !scene.unoccluded(x, None, &sample) {
                 continue;
             }
             let distance = scene.light_distance(sample.distance);
-            if !scene.light_visible(x, x, sample.wi, sample.distance) {
-                continue;
-            }
             let to_eye = medium.transmittance(ray.origin, ray.dir, 0.0, t);
             let to_light = medium.transmittance(x, sample.wi, 0.0, distance);
             let phase = medium.phase(wo, sample.wi);

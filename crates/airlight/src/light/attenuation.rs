@@ -1,6 +1,6 @@
 //! How light falls off with distance: the physical law, and the curves of
 //! real-time rendering that bring a light's reach to a finite range, after
-//! the seed (radiosity-gi-and-light-attenuation.txt, second part).
+//! Tom Madams, "Light Attenuation" and "Improved Light Attenuation" (2011).
 //!
 //! Normalisation. A light of intensity I (a sphere light of radius r and
 //! radiance L has I = π r² L) and radius r gives, on a surface facing it at

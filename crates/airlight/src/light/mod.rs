@@ -1,4 +1,4 @@
-//! Lights, in the units of DESIGN.md: point and spot `intensity` in W/sr,
+//! Lights, in the units of docs/scene-format.md: point and spot `intensity` in W/sr,
 //! distant `irradiance` on a facing surface, sphere and quad `radiance`, line
 //! `intensity` per unit length (W/(sr·m)).
 
@@ -318,6 +318,16 @@ impl Light {
                 if cos_light <= 0.0 { 0.0 } else { t * t / (area * cos_light) }
             }
             _ => 0.0,
+        }
+    }
+
+    /// The surface the camera sees and shadows meet, for sphere and quad
+    /// lights; other lights have none (points, directions, glowing air).
+    pub fn surface(&self) -> Option<crate::geometry::Shape> {
+        match *self {
+            Light::Sphere { center, radius, .. } => Some(crate::geometry::Shape::sphere(center, radius)),
+            Light::Quad { corner, edge_u, edge_v, .. } => Some(crate::geometry::Shape::quad(corner, edge_u, edge_v)),
+            _ => None,
         }
     }
 

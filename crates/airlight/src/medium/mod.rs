@@ -8,7 +8,7 @@ pub use phase::{henyey_greenstein, isotropic, sample_henyey_greenstein_cos};
 use crate::Rgb;
 use glam::Vec3;
 
-/// A medium filling all of space (DESIGN.md: `[medium]`). Coefficients are per
+/// A medium filling all of space (docs/scene-format.md: `[medium]`). Coefficients are per
 /// unit length, per RGB channel.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Medium {

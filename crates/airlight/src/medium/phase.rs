@@ -7,7 +7,7 @@ pub const fn isotropic() -> f32 {
     1.0 / (4.0 * PI)
 }
 
-/// Henyey–Greenstein as pbrt-v4 writes it (DESIGN.md):
+/// Henyey–Greenstein as pbrt-v4 writes it (docs/scene-format.md):
 /// p = (1 − g²) / (4π (1 + g² + 2g cos θ)^1.5), with cos θ between the two
 /// directions both pointing away from the scattering point, so g > 0 favours
 /// light continuing forward (cos θ = −1).

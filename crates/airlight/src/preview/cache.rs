@@ -12,9 +12,8 @@ use super::Preview;
 use crate::Camera;
 use crate::Rgb;
 use crate::film::Image;
-use crate::geometry::{Geometry, GeometryBuilder, Ray, Shape, SurfaceHit};
-use crate::integrator::surface_radiance;
-use crate::light::Light;
+use crate::geometry::{Geometry, GeometryBuilder, Ray, SurfaceHit};
+use crate::integrator::{surface_radiance, through_medium};
 use crate::radiosity::Radiosity;
 use crate::sampling::Sampler;
 use crate::scene::{PixelFilter, Scene};
@@ -57,11 +56,7 @@ pub struct FirstSample {
 impl FirstSample {
     /// An empty cache for `scene` (whose objects must not change after).
     pub fn new(scene: &Scene) -> Self {
-        let mut objects = GeometryBuilder::default();
-        for (shape, material) in &scene.objects {
-            objects.add(shape, *material, None);
-        }
-        FirstSample { key: None, objects: objects.build(), texels: Vec::new(), weights: Vec::new() }
+        FirstSample { key: None, objects: scene.objects_geometry(), texels: Vec::new(), weights: Vec::new() }
     }
 
     /// Whether the next [`FirstSample::render`] reuses the cached hits.
@@ -79,7 +74,7 @@ impl FirstSample {
             self.fill(scene, solution);
         }
         let lights = light_surfaces(scene);
-        let (w, h) = (scene.settings.width, scene.settings.height);
+        let (w, h) = (scene.settings().width, scene.settings().height);
         let mut image = Image::new(w, h);
         image.pixels.par_chunks_mut(w as usize).enumerate().for_each(|(y, row)| {
             for (x, out) in row.iter_mut().enumerate() {
@@ -91,9 +86,8 @@ impl FirstSample {
     }
 
     fn fill(&mut self, scene: &Scene, solution: Option<&Radiosity>) {
-        let s = &scene.settings;
+        let s = scene.settings();
         let (w, h) = (s.width as usize, s.height as usize);
-        let tmax = if scene.medium.is_some() { f32::INFINITY } else { s.max_distance };
         let rows: Vec<Row> = (0..h)
             .into_par_iter()
             .map(|y| {
@@ -107,14 +101,14 @@ impl FirstSample {
                             PixelFilter::Box => jitter,
                             PixelFilter::Point => Vec2::splat(0.5),
                         };
-                    let ray = scene.camera.ray(film, s.width, s.height, lens);
-                    let mut texel = Texel { ray, hit: None, t: tmax, albedo: Rgb::ZERO, start: 0, len: 0, scale: 0.0 };
-                    if let Some(hit) = self.objects.intersect(&ray, tmax) {
+                    let ray = scene.camera().ray(film, s.width, s.height, lens);
+                    let t = f32::INFINITY;
+                    let mut texel = Texel { ray, hit: None, t, albedo: Rgb::ZERO, start: 0, len: 0, scale: 0.0 };
+                    if let Some(hit) = self.objects.intersect(&ray, t) {
                         let surface = self.objects.surface(&ray, hit);
                         texel.hit = Some(surface);
                         texel.t = hit.t;
-                        texel.albedo =
-                            scene.materials[surface.material as usize].albedo(surface.p, surface.n) * FRAC_1_PI;
+                        texel.albedo = scene.material_at(&surface).albedo(surface.p, surface.n) * FRAC_1_PI;
                         if let Some(solution) = solution {
                             let n = if surface.n.dot(ray.dir) <= 0.0 { surface.n } else { -surface.n };
                             texel.start = weights.len() as u32;
@@ -154,7 +148,7 @@ impl FirstSample {
         // The camera's draws, made by the renderer before the integrator's.
         sampler.next2();
         sampler.next2();
-        let medium = scene.medium.as_ref();
+        let medium = scene.medium();
         let (surface, t_end) = match lights.intersect(ray, texel.t) {
             // A light's surface in front of the objects (it reflects nothing).
             Some(hit) => (surface_radiance(scene, ray, &lights.surface(ray, hit), &mut sampler, medium), hit.t),
@@ -175,35 +169,31 @@ impl FirstSample {
                     }
                     (l, texel.t)
                 }
-                None => (scene.settings.background, scene.settings.max_distance),
+                None => (scene.settings().background, scene.settings().max_distance),
             },
         };
-        let l = preview.through_medium(scene, ray, surface, t_end, &mut sampler);
+        let l = through_medium(scene, ray, surface, t_end, &mut sampler, |medium, length, sampler| {
+            preview.glow(scene, medium, ray, length, sampler)
+        });
         if l.is_finite() { l } else { Rgb::ZERO }
     }
 }
 
 /// Sample 0's generator of a pixel, as the renderer makes it.
 fn first_sampler(scene: &Scene, pixel: u64) -> Sampler {
-    Sampler::for_pixel(scene.settings.seed, pixel, 0)
+    Sampler::for_pixel(scene.settings().seed, pixel, 0)
 }
 
 fn key(scene: &Scene) -> Key {
-    let s = &scene.settings;
-    (scene.camera, s.width, s.height, s.seed, s.filter)
+    let s = scene.settings();
+    (*scene.camera(), s.width, s.height, s.seed, s.filter)
 }
 
 /// The surfaces of the scene's area lights where they are now.
 fn light_surfaces(scene: &Scene) -> Geometry {
-    let black = scene.materials.len() as u32 - 1;
     let mut g = GeometryBuilder::default();
-    for (i, light) in scene.lights.iter().enumerate() {
-        let shape = match *light {
-            Light::Sphere { center, radius, .. } => Shape::sphere(center, radius),
-            Light::Quad { corner, edge_u, edge_v, .. } => Shape::quad(corner, edge_u, edge_v),
-            _ => continue,
-        };
-        g.add(&shape, black, Some(i as u32));
+    for s in scene.surfaces().filter(|s| s.emitter.is_some()) {
+        g.add(&s.shape, s.material, s.emitter);
     }
     g.build()
 }
@@ -275,46 +265,51 @@ fn lookup_weights(solution: &Radiosity, p: glam::Vec3, n: glam::Vec3, out: &mut 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::medium::Medium;
-    use crate::preview::set_lights;
+    use crate::SceneFile;
+    use crate::integrator::{AnalyticOptions, RadiosityOptions, RaymarchOptions};
     use crate::render::{RenderObserver, render_samples};
     use glam::vec3;
 
     const CORNELL: &str = include_str!("../../../../scenes/cornell_box.toml");
 
     fn check(scene: &mut Scene) {
-        (scene.settings.width, scene.settings.height) = (48, 27);
-        let mut solution = Radiosity::compile(scene).unwrap();
+        (scene.settings_mut().width, scene.settings_mut().height) = (48, 27);
+        let options = RadiosityOptions::default();
+        let mut solution = Radiosity::compile(scene, &options).unwrap();
         let mut cache = FirstSample::new(scene);
-        let start = scene.lights.clone();
+        let start = scene.lights().to_vec();
+        fn preview_of<'a>(scene: &Scene, solution: Option<&'a Radiosity>) -> Preview<'a> {
+            Preview::new(scene, solution, AnalyticOptions::default(), RaymarchOptions::default())
+        }
         for (k, at) in [vec3(2.78, 5.487, 2.795), vec3(1.2, 5.0, 1.5), vec3(4.2, 5.3, 4.0)].into_iter().enumerate() {
-            let moved: Vec<Light> = start.iter().map(|l| l.moved_to(at)).collect();
-            set_lights(scene, &moved);
-            solution.update(scene);
-            let preview = Preview::new(scene, Some(&solution));
+            let moved: Vec<_> = start.iter().map(|l| l.moved_to(at)).collect();
+            scene.set_lights(&moved);
+            solution.update(scene, options.bounces);
+            let preview = preview_of(scene, Some(&solution));
             assert_eq!(cache.is_valid_for(scene), k > 0, "the camera stood still");
             let cached = cache.render(scene, Some(&solution), &preview);
             let direct = render_samples(scene, &preview, 0, 1, &RenderObserver::none());
             assert_eq!(cached, direct, "light at {at}");
             assert!(cached.mean().max_element() > 0.0);
         }
-        scene.camera.position.x += 0.1;
+        let mut camera = *scene.camera();
+        camera.position.x += 0.1;
+        scene.set_camera(camera);
         assert!(!cache.is_valid_for(scene));
-        let preview = Preview::new(scene, Some(&solution));
+        let preview = preview_of(scene, Some(&solution));
         let cached = cache.render(scene, Some(&solution), &preview);
         assert_eq!(cached, render_samples(scene, &preview, 0, 1, &RenderObserver::none()));
     }
 
     #[test]
     fn the_cached_first_sample_is_the_preview_bit_for_bit_as_the_light_moves() {
-        check(&mut crate::scene::from_toml_str(CORNELL, None).unwrap());
+        check(&mut SceneFile::from_toml_str(CORNELL, None).unwrap().scene);
     }
 
     #[test]
     fn in_a_medium_too() {
-        let mut scene = crate::scene::from_toml_str(CORNELL, None).unwrap();
-        scene.medium = Some(Medium::homogeneous(Rgb::splat(0.01), Rgb::splat(0.03), 0.0));
-        check(&mut scene);
+        let text = format!("{CORNELL}\n[medium]\nsigma_a = 0.01\nsigma_s = 0.03\n");
+        check(&mut SceneFile::from_toml_str(&text, None).unwrap().scene);
     }
 
     #[test]

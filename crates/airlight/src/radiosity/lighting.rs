@@ -10,9 +10,7 @@ use super::hierarchy::{Hierarchy, mix};
 use super::links::Links;
 use super::patches::Patch;
 use crate::Rgb;
-use crate::geometry::offset_origin;
-use crate::light::Light;
-use crate::scene::Scene;
+use crate::scene::{Scene, light_numbers};
 use glam::{Vec2, Vec3A};
 use rayon::prelude::*;
 
@@ -25,23 +23,23 @@ pub const AREA_LIGHT_SAMPLES: u32 = 1;
 /// Patches per parallel work item.
 const CHUNK: usize = 256;
 
-/// Irradiance from `lights` at every patch's centre, on the patch's side,
+/// Irradiance from the scene's lights at every patch's centre, on the patch's side,
 /// with shadow rays: delta lights once, area lights with
 /// [`AREA_LIGHT_SAMPLES`] stratified samples whose offsets are fixed per
 /// patch, so a still light gives the same value every frame.
-pub fn direct(scene: &Scene, patches: &[Patch], lights: &[Light], seed: u64, out: &mut [Rgb]) {
+pub fn direct(scene: &Scene, patches: &[Patch], seed: u64, out: &mut [Rgb]) {
     out.par_chunks_mut(CHUNK).enumerate().for_each(|(c, chunk)| {
         for (k, e) in chunk.iter_mut().enumerate() {
             let i = c * CHUNK + k;
-            *e = patch_irradiance(scene, &patches[i], lights, mix(seed ^ i as u64));
+            *e = patch_irradiance(scene, &patches[i], mix(seed ^ i as u64));
         }
     });
 }
 
-fn patch_irradiance(scene: &Scene, p: &Patch, lights: &[Light], key: u64) -> Rgb {
+fn patch_irradiance(scene: &Scene, p: &Patch, key: u64) -> Rgb {
     let mut e = Rgb::ZERO;
     let jitter = Vec2::new((key & 0xffff) as f32 / 65536.0, ((key >> 16) & 0xffff) as f32 / 65536.0);
-    for light in lights {
+    for (index, light) in scene.lights().iter().enumerate() {
         let count = if light.is_delta() { 1 } else { AREA_LIGHT_SAMPLES };
         let side = (count as f32).sqrt().ceil() as u32;
         let mut sum = Rgb::ZERO;
@@ -51,15 +49,11 @@ fn patch_irradiance(scene: &Scene, p: &Patch, lights: &[Light], key: u64) -> Rgb
             } else {
                 Vec2::new(((s % side) as f32 + jitter.x) / side as f32, ((s / side) as f32 + jitter.y) / side as f32)
             };
-            let Some(sample) = light.sample(p.center, u) else {
+            let Some(sample) = scene.sample_light(index, p.center, light_numbers(u)) else {
                 continue;
             };
             let cos = sample.wi.dot(p.normal);
-            if cos <= 0.0 || sample.weight == Rgb::ZERO {
-                continue;
-            }
-            let origin = offset_origin(p.center, p.normal, sample.wi);
-            if !scene.light_visible(p.center, origin, sample.wi, sample.distance) {
+            if cos <= 0.0 || !scene.unoccluded(p.center, Some(p.normal), &sample) {
                 continue;
             }
             sum += sample.weight * cos;

@@ -1,5 +1,5 @@
 //! Radiosity global illumination with a patch hierarchy, after the seed
-//! (radiosity-gi-and-light-attenuation.txt, first part).
+//! (Tom Madams's blog post on real-time radiosity, 2011).
 //!
 //! A static scene is compiled once ([`Radiosity::compile`]): its surfaces are
 //! cut into patches ([`patches`]), the patches clustered into a hierarchy
@@ -35,7 +35,7 @@ pub mod lookup;
 pub mod patches;
 
 use crate::Rgb;
-use crate::light::Light;
+use crate::integrator::RadiosityOptions;
 use crate::material::Material;
 use crate::scene::Scene;
 use glam::Vec3;
@@ -60,6 +60,12 @@ pub enum RadiosityError {
     TooManyPatches { patch_size: f32, estimated: f64 },
 }
 
+thread_local! {
+    /// Solutions compiled by this thread (thread-local, so that tests
+    /// running side by side do not see each other's).
+    static COMPILES: std::cell::Cell<usize> = const { std::cell::Cell::new(0) };
+}
+
 /// What compilation needs beyond the scene.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct CompileParams {
@@ -81,16 +87,21 @@ pub struct CompileParams {
 }
 
 impl CompileParams {
-    /// The scene's `[render]` settings; without `patch_size`, 1/32 of the
-    /// largest extent of the bounded geometry (1/16 of the scene's bounding
-    /// radius when there are only planes).
-    pub fn for_scene(scene: &Scene) -> Self {
-        let s = &scene.settings;
-        let patch_size = s.patch_size.unwrap_or_else(|| match scene.geometry.bounds() {
+    /// The integrator's options for `scene`; without `patch_size`, 1/32 of
+    /// the largest extent of the bounded geometry (1/16 of the scene's
+    /// bounding radius when there are only planes). Seeded by the scene's
+    /// seed.
+    pub fn for_scene(scene: &Scene, options: &RadiosityOptions) -> Self {
+        let patch_size = options.patch_size.unwrap_or_else(|| match scene.geometry().bounds() {
             Some((lo, hi)) if (hi - lo).max_element() > 0.0 => (hi - lo).max_element() / 32.0,
-            _ => scene.bounds_radius / 16.0,
+            _ => scene.bounds().1 / 16.0,
         });
-        CompileParams { patch_size, link_threshold: s.link_threshold, receiver_share: 0.0, seed: s.seed }
+        CompileParams {
+            patch_size,
+            link_threshold: options.link_threshold,
+            receiver_share: 0.0,
+            seed: scene.settings().seed,
+        }
     }
 }
 
@@ -153,33 +164,41 @@ pub struct Radiosity {
 }
 
 impl Radiosity {
-    /// Compiles `scene` with the settings of its `[render]` table, then
-    /// lights it with its lights ([`Radiosity::update`]).
-    pub fn compile(scene: &Scene) -> Result<Radiosity, RadiosityError> {
-        let mut r = Radiosity::compile_with(scene, CompileParams::for_scene(scene))?;
-        r.update(scene);
+    /// Compiles `scene` with `options`, then lights it with its lights
+    /// ([`Radiosity::update`]).
+    pub fn compile(scene: &Scene, options: &RadiosityOptions) -> Result<Radiosity, RadiosityError> {
+        let mut r = Radiosity::compile_with(scene, CompileParams::for_scene(scene, options))?;
+        r.update(scene, options.bounces);
         Ok(r)
+    }
+
+    /// How many solutions this thread has compiled (for tests that check
+    /// that animations relight instead of recompiling).
+    pub fn compile_count() -> usize {
+        COMPILES.with(|c| c.get())
     }
 
     /// Compiles `scene` (cut, cull, cluster, link); the lighting is zero
     /// until [`Radiosity::update`]. Fails, before cutting, when the patch
     /// size would make more than [`MAX_PATCHES`] patches.
     pub fn compile_with(scene: &Scene, params: CompileParams) -> Result<Radiosity, RadiosityError> {
+        COMPILES.with(|c| c.set(c.get() + 1));
         let start = Instant::now();
         let mut patches = Vec::new();
-        let square = (scene.bounds_center, scene.bounds_radius);
+        let square = scene.bounds();
         let estimated: f64 =
-            scene.objects.iter().map(|(shape, _)| patches::count(shape, params.patch_size, square)).sum();
+            scene.objects().iter().map(|(shape, _)| patches::count(shape, params.patch_size, square)).sum();
         if estimated.is_nan() || estimated > MAX_PATCHES as f64 {
             return Err(RadiosityError::TooManyPatches { patch_size: params.patch_size, estimated });
         }
-        for (index, (shape, material)) in scene.objects.iter().enumerate() {
+        for (index, (shape, material)) in scene.objects().iter().enumerate() {
             patches::cut(shape, *material, index as u32, params.patch_size, square, &mut patches);
         }
         let cut = start.elapsed();
 
         let t = Instant::now();
-        let extents: Vec<patches::Extent> = scene.objects.iter().map(|(shape, _)| patches::Extent::of(shape)).collect();
+        let extents: Vec<patches::Extent> =
+            scene.objects().iter().map(|(shape, _)| patches::Extent::of(shape)).collect();
         let keep: Vec<bool> = patches.par_iter().map(|p| patches::faces_anything(p, &extents)).collect();
         let before = patches.len();
         let mut keep = keep.into_iter();
@@ -192,10 +211,14 @@ impl Radiosity {
         let cluster = t.elapsed();
 
         let t = Instant::now();
+        // Area lights' surfaces block links too (the Cornell box's light
+        // shades the ceiling above it from bounce light: 6% of that wall's
+        // one-bounce light). Links are made once, so when such a light moves
+        // the shadow it casts on bounce light stays where it was compiled.
         let links = links::build(
             &patches,
             &hierarchy,
-            &scene.geometry,
+            scene.geometry(),
             params.link_threshold,
             params.receiver_share,
             params.seed,
@@ -243,24 +266,19 @@ impl Radiosity {
         per_patch + self.hierarchy.bytes() + self.links.bytes() + self.lookup.bytes()
     }
 
-    /// Relights with the scene's lights, materials and `bounces`.
-    pub fn update(&mut self, scene: &Scene) -> FrameTimes {
-        self.update_with(scene, &scene.lights, scene.settings.bounces)
-    }
-
-    /// The per-frame step with these `lights` (moved, dimmed: anything but
-    /// the geometry may differ from the scene's) and the scene's materials:
-    /// direct light, then `bounces` × (push, gather).
-    pub fn update_with(&mut self, scene: &Scene, lights: &[Light], bounces: u32) -> FrameTimes {
-        if self.materials != scene.materials {
-            self.materials = scene.materials.clone();
+    /// The per-frame step with the scene's lights and materials (anything
+    /// but the geometry may have changed since compiling): direct light,
+    /// then `bounces` × (push, gather).
+    pub fn update(&mut self, scene: &Scene, bounces: u32) -> FrameTimes {
+        if self.materials != scene.materials() {
+            self.materials = scene.materials().to_vec();
             for (a, p) in self.albedo.iter_mut().zip(&self.patches) {
-                *a = self.materials[p.material as usize].albedo(p.center, p.normal);
+                *a = scene.material(p.material).albedo(p.center, p.normal);
             }
         }
         let mut times = FrameTimes::default();
         let t = Instant::now();
-        lighting::direct(scene, &self.patches, lights, self.params.seed, &mut self.direct);
+        lighting::direct(scene, &self.patches, self.params.seed, &mut self.direct);
         times.direct = t.elapsed();
 
         let n = self.patches.len();

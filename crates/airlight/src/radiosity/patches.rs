@@ -4,7 +4,7 @@
 //! triangle with its centre, the unit normal of the side it stands for, its
 //! area and its material. Surfaces that enclose a solid (boxes, spheres) get
 //! patches on their outside only; open surfaces (quads, planes, meshes) are
-//! two-sided (DESIGN.md: every diffuse surface reflects on both sides), so
+//! two-sided (docs/scene-format.md: every diffuse surface reflects on both sides), so
 //! each piece gives two patches, one per side.
 //!
 //! Sizes: a quad is cut into ⌈|u|/h⌉ × ⌈|v|/h⌉ parallelograms, so no patch

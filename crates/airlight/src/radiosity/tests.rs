@@ -1,15 +1,20 @@
 use super::*;
+use crate::SceneFile;
 use crate::geometry::Shape;
-use crate::scene::{SceneBuilder, from_toml_str};
+use crate::integrator::RadiosityOptions;
+use crate::light::Light;
+use crate::scene::SceneBuilder;
 use glam::vec3;
 
 const CORNELL: &str = include_str!("../../../../scenes/cornell_box.toml");
 
-fn cornell(patch_size: f32) -> Scene {
-    let mut scene = from_toml_str(CORNELL, None).unwrap();
-    scene.settings.patch_size = Some(patch_size);
-    scene.settings.bounces = 1;
-    scene
+fn cornell() -> Scene {
+    SceneFile::from_toml_str(CORNELL, None).unwrap().scene
+}
+
+/// One bounce with patches of `patch_size`.
+fn options(patch_size: f32) -> RadiosityOptions {
+    RadiosityOptions { patch_size: Some(patch_size), bounces: 1, ..RadiosityOptions::default() }
 }
 
 fn quads(shapes: &[Shape]) -> Scene {
@@ -115,7 +120,7 @@ fn perpendicular_rectangles_match_the_closed_form() {
 fn form_factors_are_reciprocal() {
     // A_i F_ij = A_j F_ji with visibility, on random pairs of the Cornell
     // box's patches (the blocks occlude some of them).
-    let scene = cornell(0.3);
+    let scene = cornell();
     let r = compile(&scene, 0.3, DEFAULT_THRESHOLD);
     let p = r.patches();
     let mut state = 12345u64;
@@ -126,8 +131,8 @@ fn form_factors_are_reciprocal() {
         if i == j {
             continue;
         }
-        let fij = factors::form_factor(&p[i], &p[j]) * factors::visibility(&scene.geometry, p, i, j, 3);
-        let fji = factors::form_factor(&p[j], &p[i]) * factors::visibility(&scene.geometry, p, j, i, 3);
+        let fij = factors::form_factor(&p[i], &p[j]) * factors::visibility(scene.geometry(), p, i, j, 3);
+        let fji = factors::form_factor(&p[j], &p[i]) * factors::visibility(scene.geometry(), p, j, i, 3);
         let (a, b) = (p[i].area * fij, p[j].area * fji);
         // Far pairs use the symmetric point formula; near ones integrate
         // over the receiver only, to within the quadrature's error.
@@ -138,7 +143,7 @@ fn form_factors_are_reciprocal() {
     assert!(checked > 500, "too few pairs see each other: {checked}");
 }
 
-const DEFAULT_THRESHOLD: f32 = crate::scene::DEFAULT_LINK_THRESHOLD;
+const DEFAULT_THRESHOLD: f32 = crate::integrator::DEFAULT_LINK_THRESHOLD;
 
 /// Inside a closed cube every patch sees all the rest: Σ_j F_ij = 1.
 #[test]
@@ -182,12 +187,11 @@ fn relative_error(a: &[Rgb], full: &[Rgb]) -> f64 {
 
 #[test]
 fn hierarchy_matches_the_full_solution() {
-    let mut scene = cornell(0.3);
-    scene.settings.bounces = 2;
+    let scene = cornell();
     let mut full = compile(&scene, 0.3, 0.0);
-    full.update(&scene);
+    full.update(&scene, 2);
     let mut h = compile(&scene, 0.3, DEFAULT_THRESHOLD);
-    h.update(&scene);
+    h.update(&scene, 2);
     assert_eq!(h.patches(), full.patches());
     assert!(h.stats().links * 3 < full.stats().links, "clusters save links");
     let err = relative_error(h.indirect_irradiance(), full.indirect_irradiance());
@@ -200,15 +204,15 @@ fn receiver_clusters_keep_energy() {
     // With clusters receiving too, each patch's total form factor (what it
     // and its ancestors gather per unit radiosity) stays near that of the
     // patch-only solution.
-    let mut scene = cornell(0.3);
-    for m in &mut scene.materials {
+    let mut scene = cornell();
+    for m in scene.materials_mut() {
         *m = Material::diffuse(Rgb::ONE);
     }
-    let params = CompileParams { receiver_share: 0.5, ..CompileParams::for_scene(&scene) };
+    let params = CompileParams { receiver_share: 0.5, ..CompileParams::for_scene(&scene, &options(0.3)) };
     let mut with = Radiosity::compile_with(&scene, params).unwrap();
-    with.update(&scene);
+    with.update(&scene, 1);
     let mut without = compile(&scene, 0.3, DEFAULT_THRESHOLD);
-    without.update(&scene);
+    without.update(&scene, 1);
     let cluster_receivers =
         (with.patches().len()..with.links().offsets.len() - 1).filter(|&r| with.links().of(r).len() > 0).count();
     assert!(cluster_receivers > 0);
@@ -221,11 +225,11 @@ fn receiver_clusters_keep_energy() {
 
 #[test]
 fn results_do_not_depend_on_the_thread_count() {
-    let scene = cornell(0.4);
+    let scene = cornell();
     let run = |threads| {
         rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap().install(|| {
             let mut r = compile(&scene, 0.4, DEFAULT_THRESHOLD);
-            r.update(&scene);
+            r.update(&scene, 1);
             (r.links().clone(), r.indirect_irradiance().to_vec())
         })
     };
@@ -251,8 +255,8 @@ fn shading_is_continuous_across_patches() {
     // Continuous shading changes by less when the step shrinks (about in
     // proportion); a jump at a patch edge would not shrink at all. Nearest-
     // patch lookup fails this.
-    let scene = cornell(0.3);
-    let r = Radiosity::compile(&scene).unwrap();
+    let scene = cornell();
+    let r = Radiosity::compile(&scene, &options(0.3)).unwrap();
     let h = r.params().patch_size;
     let coarse = largest_step(&r, h / 10.0);
     let fine = largest_step(&r, h / 80.0);
@@ -262,17 +266,20 @@ fn shading_is_continuous_across_patches() {
 #[test]
 fn a_moved_light_needs_no_recompile() {
     // Updating with moved lights gives what compiling anew with those lights
-    // gives; so does a changed albedo.
-    let mut scene = cornell(0.4);
-    let mut r = Radiosity::compile(&scene).unwrap();
+    // gives; so does a changed albedo. (A point light, whose moving leaves
+    // the geometry the links were made against as it was.)
+    let mut scene = cornell();
+    let quad_centre = scene.lights()[0].position().unwrap();
+    scene.set_lights(&[Light::point(quad_centre - Vec3::Y * 0.1, Rgb::splat(30.0))]);
+    let mut r = Radiosity::compile(&scene, &options(0.4)).unwrap();
     let before = r.indirect_irradiance().to_vec();
-    let moved: Vec<Light> = scene.lights.iter().map(|l| l.moved_to(vec3(1.5, 5.48, 4.0))).collect();
-    r.update_with(&scene, &moved, 1);
+    let moved: Vec<Light> = scene.lights().iter().map(|l| l.moved_to(vec3(1.5, 5.0, 4.0))).collect();
+    assert!(!scene.set_lights(&moved), "a point light has no surface in the BVH");
+    r.update(&scene, 1);
     assert_ne!(r.indirect_irradiance(), &before[..]);
-    scene.lights = moved;
-    scene.materials[0] = Material::diffuse(Rgb::new(0.2, 0.9, 0.3));
-    r.update(&scene);
-    let fresh = Radiosity::compile(&scene).unwrap();
+    scene.materials_mut()[0] = Material::diffuse(Rgb::new(0.2, 0.9, 0.3));
+    r.update(&scene, 1);
+    let fresh = Radiosity::compile(&scene, &options(0.4)).unwrap();
     assert_eq!(r.indirect_irradiance(), fresh.indirect_irradiance());
 }
 
@@ -294,12 +301,12 @@ fn bfloat16_factors_round_to_nearest() {
 
 #[test]
 fn too_small_a_patch_size_is_refused_before_cutting() {
-    let scene = cornell(1e-4);
-    let e = Radiosity::compile(&scene).unwrap_err();
+    let scene = cornell();
+    let e = Radiosity::compile(&scene, &options(1e-4)).unwrap_err();
     assert!(e.to_string().contains("choose a larger patch_size"), "{e}");
     // The count matches what cutting makes, before the sides are culled.
-    let r = compile(&cornell(0.3), 0.3, DEFAULT_THRESHOLD);
-    let square = (scene.bounds_center, scene.bounds_radius);
-    let counted: f64 = scene.objects.iter().map(|(s, _)| patches::count(s, 0.3, square)).sum();
+    let r = compile(&scene, 0.3, DEFAULT_THRESHOLD);
+    let square = scene.bounds();
+    let counted: f64 = scene.objects().iter().map(|(s, _)| patches::count(s, 0.3, square)).sum();
     assert_eq!(counted as usize, r.stats().patches + r.stats().dropped);
 }

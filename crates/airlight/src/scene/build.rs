@@ -2,11 +2,10 @@
 //! Each error names the place in the file and what was expected.
 
 use super::desc::*;
-use super::{RenderSettings, Scene, SceneBuilder, SceneError, default_camera};
+use super::{MAX_IMAGE_SIDE, MAX_SPP, RenderSettings, Scene, SceneBuilder, SceneError, default_camera, desc};
 use crate::Rgb;
 use crate::camera::{Camera, Projection};
 use crate::geometry::Shape;
-use crate::integrator::IntegratorKind;
 use crate::light::{Attenuation, Keyframes, Light, SpotProfile};
 use crate::material::Material;
 use crate::medium::Medium;
@@ -15,29 +14,33 @@ use std::ops::Range;
 use std::path::Path;
 use toml::Spanned;
 
-/// Reads and builds the scene file at `path`; meshes are found relative to it.
-pub fn load(path: &Path) -> Result<Scene, SceneError> {
-    let text = std::fs::read_to_string(path)
-        .map_err(|e| SceneError::new(format!("cannot read the scene file: {e}")).in_file(path))?;
-    from_toml_str(&text, path.parent()).map_err(|e| e.in_file(path))
-}
-
-/// Builds a scene from TOML text. `base_dir` is where relative mesh paths
-/// start (None: the current directory).
-pub fn from_toml_str(text: &str, base_dir: Option<&Path>) -> Result<Scene, SceneError> {
-    let desc: SceneDesc = toml::from_str(text).map_err(|e| {
+/// Parses scene file text into its description; errors name the line and
+/// column (unknown keys at the key).
+pub fn parse(text: &str) -> Result<SceneDesc, SceneError> {
+    toml::from_str(text).map_err(|e| {
         let message = e.message().trim_end().to_string();
         match e.span() {
             Some(span) => SceneError::at(text, span.start, message),
             None => SceneError::new(message),
         }
-    })?;
-    Checker { text, base_dir }.scene(desc)
+    })
+}
+
+/// Checks a parsed scene file (`text`, for error positions) and builds its
+/// scene. `base_dir` is where relative mesh paths start (None: the current
+/// directory). The `[render]` table's integrator options are not read here
+/// (see [`crate::SceneFile`]).
+pub fn build(desc: &SceneDesc, text: &str, base_dir: Option<&Path>) -> Result<Scene, SceneError> {
+    // The same text parsed to a spanned document: where each key and value
+    // stands, for errors found after deserializing.
+    let document = toml::de::DeTable::parse(text).map(|d| d.into_inner()).unwrap_or_default();
+    Checker { text, base_dir, document }.scene(desc)
 }
 
 pub(super) struct Checker<'a> {
     text: &'a str,
     base_dir: Option<&'a Path>,
+    document: toml::de::DeTable<'a>,
 }
 
 pub(super) type Result<T, E = SceneError> = std::result::Result<T, E>;
@@ -55,42 +58,17 @@ impl Checker<'_> {
         SceneError::at(self.text, self.locate(span.start, field), message)
     }
 
-    /// The offset of `field`'s value in the table starting at `start`, or
-    /// `start` when the field is not written there.
+    /// The offset of `field`'s value in the table that starts at `start`,
+    /// looked up in the parsed document; `start` when the table does not
+    /// spell the field out.
     fn locate(&self, start: usize, field: &str) -> usize {
-        // An inline table ({ a = 1, b = 2 }) spells its fields on its first line.
-        let first_line = self.text[start..].split('\n').next().unwrap_or("");
-        let mut from = 0;
-        while let Some(found) = first_line[from..].find(field) {
-            let at = from + found;
-            let before = first_line[..at].trim_end().chars().last();
-            let after = first_line[at + field.len()..].trim_start();
-            if matches!(before, Some('{') | Some(',')) && after.starts_with('=') {
-                let value = after[1..].trim_start();
-                return start + first_line.len() - value.len();
-            }
-            from = at + field.len();
-        }
-        let mut offset = start;
-        for (i, line) in self.text[start..].split_inclusive('\n').enumerate() {
-            let trimmed = line.trim_start();
-            if i > 0 && trimmed.starts_with('[') {
-                break;
-            }
-            if let Some(rest) = trimmed.strip_prefix(field) {
-                let rest_trimmed = rest.trim_start();
-                if let Some(value) = rest_trimmed.strip_prefix('=') {
-                    let value_start = line.len() - value.trim_start().len();
-                    return offset + value_start;
-                }
-            }
-            offset += line.len();
-        }
-        start
+        find_table(&self.document, start)
+            .and_then(|table| table.iter().find(|(key, _)| key.get_ref() == field))
+            .map_or(start, |(_, value)| value.span().start)
     }
 
-    fn scene(&self, desc: SceneDesc) -> Result<Scene> {
-        let settings = self.settings(&desc)?;
+    fn scene(&self, desc: &SceneDesc) -> Result<Scene> {
+        let settings = self.settings(desc)?;
         let mut builder = SceneBuilder::new().settings(settings);
         if let Some(camera) = &desc.camera {
             builder = builder.camera(self.camera(camera)?);
@@ -102,7 +80,7 @@ impl Checker<'_> {
             builder = builder.material(name, self.material(name, material)?);
         }
         for (i, object) in desc.objects.iter().enumerate() {
-            let (shape, material) = self.object(i, object, &desc)?;
+            let (shape, material) = self.object(i, object, desc)?;
             builder = builder.object(shape, &material);
         }
         for (i, light) in desc.lights.iter().enumerate() {
@@ -118,29 +96,18 @@ impl Checker<'_> {
     fn settings(&self, desc: &SceneDesc) -> Result<RenderSettings> {
         let r = &desc.render;
         let mut s = RenderSettings::default();
-        // With fog and no integrator named, show the fog.
-        if desc.medium.is_some() {
-            s.integrator = IntegratorKind::Raymarch;
+        let located = |e: desc::FieldError| self.err(e.span, e.message);
+        if let Some(v) = &r.width {
+            s.width = desc::render_count(v, "width", 1, MAX_IMAGE_SIDE).map_err(located)?;
         }
-        let count = |v: &Option<Spanned<i64>>, name: &str, min: i64, default: u32| -> Result<u32> {
-            match v {
-                None => Ok(default),
-                Some(v) if *v.get_ref() >= min && *v.get_ref() <= u32::MAX as i64 => Ok(*v.get_ref() as u32),
-                Some(v) => {
-                    Err(self.err(v.span(), format!("render.{name} must be an integer ≥ {min}, got {}", v.get_ref())))
-                }
-            }
-        };
-        s.width = count(&r.width, "width", 1, s.width)?;
-        s.height = count(&r.height, "height", 1, s.height)?;
-        s.spp = count(&r.spp, "spp", 1, s.spp)?;
-        s.steps = count(&r.steps, "steps", 1, s.steps)?;
-        s.max_depth = count(&r.max_depth, "max_depth", 1, s.max_depth)?;
+        if let Some(v) = &r.height {
+            s.height = desc::render_count(v, "height", 1, MAX_IMAGE_SIDE).map_err(located)?;
+        }
+        if let Some(v) = &r.spp {
+            s.spp = desc::render_count(v, "spp", 1, MAX_SPP).map_err(located)?;
+        }
         if let Some(seed) = &r.seed {
             s.seed = *seed.get_ref() as u64;
-        }
-        if let Some(integrator) = r.integrator {
-            s.integrator = integrator;
         }
         if let Some(d) = &r.max_distance {
             s.max_distance = self.positive(d.span(), "render.max_distance", *d.get_ref())?;
@@ -151,42 +118,18 @@ impl Checker<'_> {
         if let Some(e) = &r.exposure {
             s.exposure = self.finite(e.span(), "render.exposure", *e.get_ref())?;
         }
-        if let Some(t) = r.tonemap {
-            s.tonemap = t;
-        }
-        if let Some(j) = r.jitter {
-            s.jitter = j;
+        if let Some(t) = &r.tonemap {
+            s.tonemap = desc::parse_name(t, "render.tonemap").map_err(located)?;
         }
         if let Some(c) = r.cull_lights {
             s.cull_lights = c;
         }
-        if let Some(f) = r.filter {
-            s.filter = f;
+        if let Some(f) = &r.filter {
+            s.filter = desc::parse_name(f, "render.filter").map_err(located)?;
         }
-        if let Some(p) = &r.patch_size {
-            s.patch_size = Some(self.positive(p.span(), "render.patch_size", *p.get_ref())?);
-        }
-        s.bounces = count(&r.bounces, "bounces", 1, s.bounces)?;
-        if let Some(t) = &r.link_threshold {
-            s.link_threshold = self.positive(t.span(), "render.link_threshold", *t.get_ref())?;
-        }
-        if let Some(v) = r.shadows {
-            s.shadows = v;
-        }
-        s.light_steps = count(&r.light_steps, "light_steps", 1, s.light_steps)?;
-        if let Some(v) = &r.light_steps
-            && *v.get_ref() > 4096
-        {
-            return Err(self.err(v.span(), format!("render.light_steps must be at most 4096, got {}", v.get_ref())));
-        }
-        if let Some(q) = r.light_quadrature {
-            s.light_quadrature = q;
-        }
-        if let Some(v) = r.sampling {
-            s.sampling = v;
-        }
-        if let Some(v) = r.stratify {
-            s.stratify = v;
+        if let Err(message) = s.validate() {
+            let span = r.height.as_ref().or(r.width.as_ref()).map_or(0..0, |v| v.span());
+            return Err(self.err(span, message));
         }
         Ok(s)
     }
@@ -743,4 +686,19 @@ fn list(names: &[&str]) -> String {
         return "(none)".into();
     }
     names.iter().map(|n| format!("`{n}`")).collect::<Vec<_>>().join(", ")
+}
+
+/// The table (at any depth: nested, in arrays of tables, inline) whose span
+/// starts at `start`.
+fn find_table<'d, 'i>(table: &'d toml::de::DeTable<'i>, start: usize) -> Option<&'d toml::de::DeTable<'i>> {
+    use toml::de::DeValue;
+    fn in_value<'d, 'i>(value: &'d toml::Spanned<DeValue<'i>>, start: usize) -> Option<&'d toml::de::DeTable<'i>> {
+        match value.get_ref() {
+            DeValue::Table(t) if value.span().start == start => Some(t),
+            DeValue::Table(t) => find_table(t, start),
+            DeValue::Array(items) => items.iter().find_map(|item| in_value(item, start)),
+            _ => None,
+        }
+    }
+    table.values().find_map(|value| in_value(value, start))
 }

@@ -1,11 +1,8 @@
-//! The scene file as written: plain serde structs for DESIGN.md's "Scene file
-//! schema (version 1)". Unknown keys are errors. `build.rs` checks the values
+//! The scene file as written: plain serde structs for the format that
+//! docs/scene-format.md describes. Unknown keys are errors. `build.rs` checks the values
 //! and turns them into a [`Scene`](super::Scene).
 
-use crate::integrator::analytic::LightQuadrature;
-use crate::integrator::{IntegratorKind, Sampling};
 use crate::light::{AttenuationModel, SpotProfile};
-use crate::scene::Tonemap;
 use glam::Vec3;
 use serde::Deserialize;
 use serde::de::{self, Deserializer, SeqAccess, Visitor};
@@ -29,12 +26,17 @@ pub struct SceneDesc {
     pub lights: Vec<Spanned<LightDesc>>,
 }
 
+/// The `[render]` table: film and sampling settings, which the scene keeps
+/// ([`super::RenderSettings`]), and the integrators' options, which
+/// [`crate::integrator::IntegratorDesc`] reads from here. Names of closed
+/// sets (integrator, tone curve, …) are read as text and checked by the type
+/// that owns them, at the value's position.
 #[derive(Debug, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RenderDesc {
     pub width: Option<Spanned<i64>>,
     pub height: Option<Spanned<i64>>,
-    pub integrator: Option<IntegratorKind>,
+    pub integrator: Option<Spanned<String>>,
     pub spp: Option<Spanned<i64>>,
     pub steps: Option<Spanned<i64>>,
     pub max_distance: Option<Spanned<f32>>,
@@ -42,10 +44,10 @@ pub struct RenderDesc {
     pub seed: Option<Spanned<i64>>,
     pub background: Option<Spanned<Triple>>,
     pub exposure: Option<Spanned<f32>>,
-    pub tonemap: Option<Tonemap>,
+    pub tonemap: Option<Spanned<String>>,
     pub jitter: Option<bool>,
     pub cull_lights: Option<bool>,
-    pub filter: Option<crate::scene::PixelFilter>,
+    pub filter: Option<Spanned<String>>,
     /// Radiosity: patch side length in world units (default: 1/32 of the
     /// largest extent of the bounded geometry).
     pub patch_size: Option<Spanned<f32>>,
@@ -56,9 +58,9 @@ pub struct RenderDesc {
     pub link_threshold: Option<Spanned<f32>>,
     pub shadows: Option<bool>,
     pub light_steps: Option<Spanned<i64>>,
-    pub light_quadrature: Option<LightQuadrature>,
+    pub light_quadrature: Option<Spanned<String>>,
     /// Stochastic: uniform | equiangular | mis.
-    pub sampling: Option<Sampling>,
+    pub sampling: Option<Spanned<String>>,
     /// Stochastic: stratify each pixel's samples.
     pub stratify: Option<bool>,
 }
@@ -299,6 +301,33 @@ impl From<SpotProfileDesc> for SpotProfile {
             SpotProfileDesc::Linear => SpotProfile::Linear,
         }
     }
+}
+
+/// A value of the file found wrong after parsing: where it is (a byte range
+/// of the text) and what was expected.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FieldError {
+    pub span: std::ops::Range<usize>,
+    pub message: String,
+}
+
+/// An integer key of `[render]` that must lie in [min, max].
+pub fn render_count(v: &Spanned<i64>, key: &str, min: u32, max: u32) -> Result<u32, FieldError> {
+    let n = *v.get_ref();
+    if (min as i64..=max as i64).contains(&n) {
+        Ok(n as u32)
+    } else {
+        Err(FieldError {
+            span: v.span(),
+            message: format!("render.{key} must be an integer from {min} to {max}, got {n}"),
+        })
+    }
+}
+
+/// A name from a closed set (an integrator, a tone curve, …), parsed by the
+/// type that owns the set; its error placed at the value.
+pub fn parse_name<T: std::str::FromStr<Err = String>>(v: &Spanned<String>, key: &str) -> Result<T, FieldError> {
+    v.get_ref().parse().map_err(|e| FieldError { span: v.span(), message: format!("{key}: {e}") })
 }
 
 /// A point or vector: exactly three numbers (integers allowed).

@@ -1,89 +1,87 @@
 //! The render-time [`Scene`], the [`SceneBuilder`] that makes one in Rust, and
 //! the TOML scene description ([`SceneDesc`]) that makes one from a file.
+//!
+//! A scene holds geometry, lights, the medium, the camera and the film
+//! settings; which integrator renders it, with what options, is not its
+//! business (see [`crate::integrator::IntegratorDesc`]). It changes only
+//! through its own methods, which keep what depends on each other in step:
+//! moving a light ([`Scene::set_lights`], [`Scene::at_time`]) moves its
+//! visible surface and the shadow it casts, and re-sorts the light culling.
 
 mod build;
-mod desc;
+pub mod desc;
 mod error;
 mod lights;
 mod sdf;
 
-pub use build::{from_toml_str, load};
+pub use build::{build, parse};
 pub use desc::SceneDesc;
 pub use error::{SceneError, line_col};
 pub use lights::LightCulling;
 
 use crate::Rgb;
 use crate::camera::Camera;
-use crate::geometry::{Geometry, GeometryBuilder, Shape};
-use crate::integrator::analytic::LightQuadrature;
-use crate::integrator::{IntegratorKind, Sampling};
-use crate::light::{Keyframes, Light};
+use crate::film::Tonemap;
+use crate::geometry::{Geometry, GeometryBuilder, Shape, SurfaceHit, offset_origin};
+use crate::light::{Keyframes, Light, LightSample, third_dimension};
 use crate::material::Material;
 use crate::medium::Medium;
-use glam::{Affine3A, Vec3};
+use glam::{Affine3A, Vec2, Vec3};
 use std::collections::HashMap;
 
-/// How the image is turned into 8-bit PNG values (EXR output is always linear).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum Tonemap {
-    /// Clip to [0, 1].
-    #[default]
-    Clamp,
-    /// The ACES filmic curve as fitted by Narkowicz (2015).
-    Filmic,
-}
-
-/// The `[render]` settings.
+/// The film and sampling settings of `[render]`: what every integrator
+/// shares. Integrators' own options live in [`crate::integrator`].
 #[derive(Clone, Debug, PartialEq)]
 pub struct RenderSettings {
     pub width: u32,
     pub height: u32,
-    pub integrator: IntegratorKind,
     /// Samples per pixel.
     pub spp: u32,
-    /// March samples per ray (raymarch).
-    pub steps: u32,
-    /// How far a ray that hits nothing is followed (and marched).
-    pub max_distance: f32,
-    /// Most scattering events (path).
-    pub max_depth: u32,
     pub seed: u64,
+    /// How far a ray that hits nothing is followed, and how far along any
+    /// camera ray the medium is integrated (a surface beyond it is still
+    /// seen, attenuated by the medium all the way).
+    pub max_distance: f32,
     /// Radiance of rays that escape.
     pub background: Rgb,
     /// Stops, for PNG output only.
     pub exposure: f32,
     pub tonemap: Tonemap,
-    /// Offset march samples by a random fraction of a step per pixel sample.
-    pub jitter: bool,
-    /// analytic: volumetric shadows (lit intervals of each ray).
-    pub shadows: bool,
-    /// analytic: points per dimension of a line or quad light's superposition.
-    pub light_steps: u32,
-    /// analytic: how those points are placed and weighted.
-    pub light_quadrature: LightQuadrature,
-    /// Radiosity: the side length (world units) surfaces are cut into
-    /// patches of; None picks 1/32 of the largest extent of the bounded
-    /// geometry (see `radiosity::CompileParams`).
-    pub patch_size: Option<f32>,
-    /// Radiosity: bounces of indirect light (1 = one bounce, as the seed).
-    pub bounces: u32,
-    /// Radiosity: a patch links to a whole cluster instead of its children
-    /// when the cluster's estimated form factor A_j/(π d²) is below this.
-    pub link_threshold: f32,
-    /// Skip lights whose range ends before a point (finite-range falloffs).
-    pub cull_lights: bool,
-    /// Stochastic: how the point on the camera segment is drawn.
-    pub sampling: Sampling,
-    /// Stochastic: stratify each pixel's samples (Owen-scrambled Sobol').
-    pub stratify: bool,
     /// How a pixel gathers its samples.
     pub filter: PixelFilter,
+    /// Skip lights whose range ends before a point (finite-range falloffs).
+    pub cull_lights: bool,
+}
+
+/// Largest image side.
+pub const MAX_IMAGE_SIDE: u32 = 1 << 16;
+/// Most pixels in an image (16384²).
+pub const MAX_PIXELS: u64 = 1 << 28;
+/// Most samples per pixel.
+pub const MAX_SPP: u32 = 1 << 24;
+
+impl RenderSettings {
+    /// Checks the sizes and counts; a message names the key and its bound.
+    pub fn validate(&self) -> Result<(), String> {
+        let (w, h) = (self.width, self.height);
+        if !(1..=MAX_IMAGE_SIDE).contains(&w) || !(1..=MAX_IMAGE_SIDE).contains(&h) {
+            return Err(format!("the image size must be from 1×1 to {MAX_IMAGE_SIDE}×{MAX_IMAGE_SIDE}, got {w}×{h}"));
+        }
+        if w as u64 * h as u64 > MAX_PIXELS {
+            return Err(format!("the image may have at most {MAX_PIXELS} pixels (16384²), got {w}×{h}"));
+        }
+        if !(1..=MAX_SPP).contains(&self.spp) {
+            return Err(format!("spp must be an integer from 1 to {MAX_SPP}, got {}", self.spp));
+        }
+        if !(self.max_distance.is_finite() && self.max_distance > 0.0) {
+            return Err(format!("max_distance must be a positive finite number, got {}", self.max_distance));
+        }
+        Ok(())
+    }
 }
 
 /// How the samples of a pixel are placed.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Deserialize)]
-#[serde(rename_all = "lowercase")]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum PixelFilter {
     /// The mean over the pixel's square: samples jittered across it (anti-aliasing).
     #[default]
@@ -93,66 +91,232 @@ pub enum PixelFilter {
     Point,
 }
 
+impl std::str::FromStr for PixelFilter {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "box" => Ok(PixelFilter::Box),
+            "point" => Ok(PixelFilter::Point),
+            _ => Err(format!("unknown filter `{s}`; expected box or point")),
+        }
+    }
+}
+
 impl Default for RenderSettings {
     fn default() -> Self {
         RenderSettings {
             width: 640,
             height: 480,
-            integrator: IntegratorKind::Direct,
             spp: 16,
-            steps: 64,
-            max_distance: 100.0,
-            max_depth: 8,
             seed: 0,
+            max_distance: 100.0,
             background: Rgb::ZERO,
             exposure: 0.0,
             tonemap: Tonemap::Clamp,
-            jitter: true,
-            cull_lights: true,
             filter: PixelFilter::Box,
-            patch_size: None,
-            bounces: 1,
-            link_threshold: DEFAULT_LINK_THRESHOLD,
-            shadows: false,
-            light_steps: 16,
-            light_quadrature: LightQuadrature::Gauss,
-            sampling: Sampling::default(),
-            stratify: true,
+            cull_lights: true,
         }
     }
 }
 
-/// Default of [`RenderSettings::link_threshold`].
-pub const DEFAULT_LINK_THRESHOLD: f32 = 0.02;
+/// The material index of an area light's own surface: it reflects nothing.
+const LIGHT_SURFACE: u32 = u32::MAX;
 
-/// Everything a render needs, built and validated.
+/// Everything a render needs, built and validated. See the module
+/// documentation for what it keeps in step.
 #[derive(Debug)]
 pub struct Scene {
-    pub settings: RenderSettings,
-    pub camera: Camera,
-    pub materials: Vec<Material>,
-    pub lights: Vec<Light>,
-    /// For each light in `lights`, the path it moves along in animations
-    /// (None: it stays put). See [`crate::light::Keyframes`].
-    pub light_paths: Vec<Option<Keyframes>>,
-    pub medium: Option<Medium>,
-    pub geometry: Geometry,
+    settings: RenderSettings,
+    camera: Camera,
+    materials: Vec<Material>,
+    lights: Vec<Light>,
+    /// For each light, the path it moves along in animations (None: it
+    /// stays put). See [`crate::light::Keyframes`].
+    light_paths: Vec<Option<Keyframes>>,
+    /// Never a vacuum: a medium that neither absorbs nor scatters is none.
+    medium: Option<Medium>,
     /// The scene's objects (not the lights' surfaces), in world space, with
-    /// their material index: what radiosity cuts into patches.
-    pub objects: Vec<(Shape, u32)>,
-    /// Centre and radius of a sphere around the bounded geometry, the lights
-    /// and the camera; a sun's light enters the scene from its surface, as in
-    /// pbrt-v4 and Mitsuba 3.
-    pub bounds_center: Vec3,
-    pub bounds_radius: f32,
-    pub light_culling: LightCulling,
+    /// their material index.
+    objects: Vec<(Shape, u32)>,
+    geometry: Geometry,
+    bounds_center: Vec3,
+    bounds_radius: f32,
+    light_culling: LightCulling,
 }
 
 impl Scene {
+    pub fn settings(&self) -> &RenderSettings {
+        &self.settings
+    }
+
+    /// The film settings, to change (size, samples, seed, …); a render
+    /// checks them ([`RenderSettings::validate`]).
+    pub fn settings_mut(&mut self) -> &mut RenderSettings {
+        &mut self.settings
+    }
+
+    pub fn camera(&self) -> &Camera {
+        &self.camera
+    }
+
+    /// Moves the camera (the scene's bounding sphere follows).
+    pub fn set_camera(&mut self, camera: Camera) {
+        self.camera = camera;
+        self.update_bounds();
+    }
+
+    /// The materials the scene's objects name, in the order defined.
+    pub fn materials(&self) -> &[Material] {
+        &self.materials
+    }
+
+    /// The materials, to change their values (radiosity relights with them).
+    pub fn materials_mut(&mut self) -> &mut [Material] {
+        &mut self.materials
+    }
+
+    /// The material of a surface: its object's, or black for an area light's
+    /// own surface (it emits, it does not reflect).
+    #[inline]
+    pub fn material(&self, index: u32) -> &Material {
+        self.materials.get(index as usize).unwrap_or(&Material::BLACK)
+    }
+
+    /// The material at a hit.
+    #[inline]
+    pub fn material_at(&self, surface: &SurfaceHit) -> &Material {
+        self.material(surface.material)
+    }
+
+    pub fn lights(&self) -> &[Light] {
+        &self.lights
+    }
+
+    /// For each light, the path it moves along in animations.
+    pub fn light_paths(&self) -> &[Option<Keyframes>] {
+        &self.light_paths
+    }
+
+    /// The participating medium, if there is one that absorbs or scatters.
+    pub fn medium(&self) -> Option<&Medium> {
+        self.medium.as_ref()
+    }
+
+    pub fn geometry(&self) -> &Geometry {
+        &self.geometry
+    }
+
+    /// The scene's objects in world space with their material index; the
+    /// lights' surfaces are not among them (see [`Scene::surfaces`]).
+    pub fn objects(&self) -> &[(Shape, u32)] {
+        &self.objects
+    }
+
+    /// Every surface rays can meet, as shapes: the objects with their
+    /// material, then the sphere and quad lights' surfaces with the index of
+    /// their light. The geometry's BVH is built from exactly these.
+    pub fn surfaces(&self) -> impl Iterator<Item = Surface> + '_ {
+        let objects = self.objects.iter().map(|(shape, material)| Surface {
+            shape: shape.clone(),
+            material: *material,
+            emitter: None,
+        });
+        let lights = self.lights.iter().enumerate().filter_map(|(i, light)| {
+            Some(Surface { shape: light.surface()?, material: LIGHT_SURFACE, emitter: Some(i as u32) })
+        });
+        objects.chain(lights)
+    }
+
+    /// A BVH of the objects alone, without the lights' surfaces: for what is
+    /// computed once while lights move (the viewer's cached camera hits).
+    pub fn objects_geometry(&self) -> Geometry {
+        build_geometry(self.surfaces().filter(|s| s.emitter.is_none()))
+    }
+
+    /// Centre and radius of a sphere around the bounded geometry, the lights
+    /// and the camera; a sun's light enters the scene from its surface, as in
+    /// pbrt-v4 and Mitsuba 3.
+    pub fn bounds(&self) -> (Vec3, f32) {
+        (self.bounds_center, self.bounds_radius)
+    }
+
+    pub fn light_culling(&self) -> &LightCulling {
+        &self.light_culling
+    }
+
+    /// Replaces the lights (moved, dimmed, others) and brings everything
+    /// that depends on them in step: the area lights' surfaces in the BVH
+    /// (so the camera sees a light where it now is and its old surface casts
+    /// no shadow), the light culling and the bounding sphere. Lights beyond
+    /// the old count get no animation path. Returns whether the BVH was
+    /// rebuilt (only when an area light's surface changed).
+    pub fn set_lights(&mut self, lights: &[Light]) -> bool {
+        let surfaces_moved = self.lights.len() != lights.len()
+            || self.lights.iter().zip(lights).any(|(a, b)| a.surface() != b.surface());
+        self.lights = lights.to_vec();
+        self.light_paths.resize(self.lights.len(), None);
+        self.light_culling = LightCulling::new(&self.lights);
+        if surfaces_moved {
+            self.geometry = build_geometry(self.surfaces());
+        }
+        self.update_bounds();
+        surfaces_moved
+    }
+
+    /// Moves every light with keyframes to where it is at `time` in [0, 1]
+    /// of the animation (see [`Scene::set_lights`] for what follows).
+    /// Returns whether the BVH was rebuilt.
+    pub fn at_time(&mut self, time: f32) -> bool {
+        let lights = self.lights_at(time);
+        self.set_lights(&lights)
+    }
+
+    /// The lights at `time` of the animation, without changing the scene.
+    pub fn lights_at(&self, time: f32) -> Vec<Light> {
+        self.lights
+            .iter()
+            .zip(&self.light_paths)
+            .map(|(light, path)| match path {
+                Some(path) => light.moved_to(path.at(time)),
+                None => *light,
+            })
+            .collect()
+    }
+
+    /// Whether any light moves.
+    pub fn is_animated(&self) -> bool {
+        self.light_paths.iter().any(Option::is_some)
+    }
+
+    fn update_bounds(&mut self) {
+        (self.bounds_center, self.bounds_radius) = bounding_sphere(&self.geometry, &self.lights, &self.camera);
+    }
+
     /// The distance a shadow ray toward a light sample should span: the
     /// sample's distance, or for a sun, across the scene's bounding sphere.
     pub fn light_distance(&self, distance: f32) -> f32 {
         if distance.is_finite() { distance } else { 2.0 * self.bounds_radius }
+    }
+
+    /// Light from light `index` arriving at `p`, drawn with the uniform
+    /// numbers `u` (volume lights use all three, others the first two);
+    /// None when the light sends none there. Blockers are not tested: see
+    /// [`Scene::unoccluded`]. Every light-sampling loop goes through here.
+    #[inline]
+    pub fn sample_light(&self, index: usize, p: Vec3, u: Vec3) -> Option<LightSample> {
+        let sample = self.lights[index].sample3(p, u)?;
+        (sample.weight != Rgb::ZERO).then_some(sample)
+    }
+
+    /// Whether nothing blocks `sample` (a light sample seen from `p`). On a
+    /// surface, give its normal: the shadow ray starts lifted off it.
+    #[inline]
+    pub fn unoccluded(&self, p: Vec3, normal: Option<Vec3>, sample: &LightSample) -> bool {
+        let origin = match normal {
+            Some(n) => offset_origin(p, n, sample.wi),
+            None => p,
+        };
+        self.light_visible(p, origin, sample.wi, sample.distance)
     }
 
     /// Whether the light sample at `p + wi·distance` (a sun's when distance
@@ -201,26 +365,45 @@ impl Scene {
         });
     }
 
-    /// The lights at `time` in [0, 1] of the animation: each light with
-    /// keyframes moved to its keyframed position, the others as they are.
-    pub fn lights_at(&self, time: f32) -> Vec<Light> {
-        self.lights
-            .iter()
-            .zip(&self.light_paths)
-            .map(|(light, path)| match path {
-                Some(path) => light.moved_to(path.at(time)),
-                None => *light,
-            })
-            .collect()
-    }
-
-    /// Whether any light moves.
-    pub fn is_animated(&self) -> bool {
-        self.light_paths.iter().any(Option::is_some)
+    /// Replaces the falloff model of every point, spot and sphere light
+    /// (each keeps its radius, cutoff and range).
+    pub fn set_attenuation_model(&mut self, model: crate::light::AttenuationModel) -> Result<(), String> {
+        let mut lights = self.lights.clone();
+        for light in &mut lights {
+            if let Some(a) = light.attenuation() {
+                *light = light.with_attenuation(a.with_model(model)?);
+            }
+        }
+        self.set_lights(&lights);
+        Ok(())
     }
 }
 
-/// Builds a [`Scene`] in Rust, as the seed's World/Camera example does.
+/// Three uniform numbers for [`Scene::sample_light`] from two: the third,
+/// which only volume lights use, a hash of the two.
+#[inline]
+pub fn light_numbers(u: Vec2) -> Vec3 {
+    u.extend(third_dimension(u))
+}
+
+/// One surface of a scene: its shape in world space, its material index
+/// (see [`Scene::material`]) and the light it is the surface of, if any.
+#[derive(Clone, Debug)]
+pub struct Surface {
+    pub shape: Shape,
+    pub material: u32,
+    pub emitter: Option<u32>,
+}
+
+fn build_geometry(surfaces: impl Iterator<Item = Surface>) -> Geometry {
+    let mut geometry = GeometryBuilder::default();
+    for s in surfaces {
+        geometry.add(&s.shape, s.material, s.emitter);
+    }
+    geometry.build()
+}
+
+/// Builds a [`Scene`] in Rust, as a World/Camera example in a tutorial would.
 #[derive(Default)]
 pub struct SceneBuilder {
     settings: RenderSettings,
@@ -301,74 +484,37 @@ impl SceneBuilder {
 
     /// Checks and builds the scene, with its BVH.
     pub fn build(self) -> Result<Scene, SceneError> {
-        let SceneBuilder { settings, camera, mut materials, material_names, objects, lights, light_paths, medium } =
-            self;
-        if settings.width == 0 || settings.height == 0 {
-            return Err(SceneError::new(format!(
-                "image size must be at least 1×1, got {}×{}",
-                settings.width, settings.height
-            )));
-        }
-        if settings.spp == 0 {
-            return Err(SceneError::new("spp must be at least 1"));
-        }
-        if settings.steps == 0 {
-            return Err(SceneError::new("steps must be at least 1"));
-        }
-        if settings.light_steps == 0 {
-            return Err(SceneError::new("light_steps must be at least 1"));
-        }
+        let SceneBuilder { settings, camera, materials, material_names, objects, lights, light_paths, medium } = self;
+        settings.validate().map_err(SceneError::new)?;
         let camera = camera.unwrap_or_else(default_camera);
-        if settings.bounces == 0 {
-            return Err(SceneError::new("bounces must be at least 1"));
-        }
-        if settings.patch_size.is_some_and(|p| !(p.is_finite() && p > 0.0)) {
-            return Err(SceneError::new("patch_size must be a positive number"));
-        }
-        if !(settings.link_threshold.is_finite() && settings.link_threshold > 0.0) {
-            return Err(SceneError::new("link_threshold must be a positive number"));
-        }
-        let mut geometry = GeometryBuilder::default();
         let mut placed = Vec::with_capacity(objects.len());
         for (shape, name) in objects {
             let Some(&material) = material_names.get(&name) else {
                 return Err(SceneError::new(format!("unknown material `{name}`")));
             };
-            geometry.add(&shape, material, None);
             placed.push((shape, material));
         }
-        // Area lights are surfaces too: the camera sees them, and they cast
-        // shadows. They reflect nothing.
-        let black = materials.len() as u32;
-        materials.push(Material::BLACK);
-        for (i, light) in lights.iter().enumerate() {
-            let shape = match *light {
-                Light::Sphere { center, radius, .. } => Shape::sphere(center, radius),
-                Light::Quad { corner, edge_u, edge_v, .. } => Shape::quad(corner, edge_u, edge_v),
-                _ => continue,
-            };
-            geometry.add(&shape, black, Some(i as u32));
-        }
-        let geometry = geometry.build();
-        let (bounds_center, bounds_radius) = bounding_sphere(&geometry, &lights, &camera);
         let light_culling = LightCulling::new(&lights);
-        Ok(Scene {
+        let mut scene = Scene {
             settings,
             camera,
             materials,
             lights,
             light_paths,
-            medium,
-            geometry,
+            medium: medium.filter(|m| !m.is_vacuum()),
             objects: placed,
-            bounds_center,
-            bounds_radius,
+            geometry: Geometry::default(),
+            bounds_center: Vec3::ZERO,
+            bounds_radius: 1.0,
             light_culling,
-        })
+        };
+        scene.geometry = build_geometry(scene.surfaces());
+        scene.update_bounds();
+        Ok(scene)
     }
 }
 
-/// The camera of a scene that names none: DESIGN.md's example camera.
+/// The camera of a scene that names none.
 pub fn default_camera() -> Camera {
     Camera::look_at(Vec3::new(0.0, 2.0, -6.0), Vec3::new(0.0, 1.0, 0.0), Vec3::Y, 40.0)
 }

@@ -2,7 +2,7 @@ use super::*;
 use glam::vec3;
 
 fn scene() -> Scene {
-    airlight::scene::from_toml_str(crate::view::DEFAULT_SCENE, None).unwrap()
+    airlight::SceneFile::from_toml_str(crate::view::DEFAULT_SCENE, None).unwrap().scene
 }
 
 fn err(text: &str) -> String {
@@ -13,8 +13,8 @@ fn err(text: &str) -> String {
 fn an_empty_script_keeps_the_scene_as_it_is() {
     let s = scene();
     let script = parse("", &s).unwrap();
-    assert_eq!(script.camera_at(7, &s.camera), s.camera);
-    assert_eq!(script.lights_at(7, 10, &s.lights, &s.light_paths), s.lights);
+    assert_eq!(script.camera_at(7, s.camera()), *s.camera());
+    assert_eq!(script.lights_at(7, 10, s.lights(), s.light_paths()), s.lights());
     assert_eq!(script.integrator, None);
 }
 
@@ -44,24 +44,24 @@ position = [3, 5, 1]
 "#;
     let script = parse(text, &s).unwrap();
     assert_eq!(script.integrator, Some(Mode::Raymarch));
-    let c = script.camera_at(15, &s.camera);
+    let c = script.camera_at(15, s.camera());
     assert!((c.position - vec3(1.0, 1.0, -5.0)).length() < 1e-6);
     assert!((c.forward - Vec3::Z).length() < 1e-6);
     assert_eq!(c.projection, Projection::Perspective { fov_degrees: 50.0 });
-    assert_eq!(script.camera_at(0, &s.camera).position, vec3(0.0, 1.0, -5.0));
-    assert_eq!(script.camera_at(99, &s.camera).position, vec3(2.0, 1.0, -5.0));
-    let lights = script.lights_at(1, 10, &s.lights, &s.light_paths);
+    assert_eq!(script.camera_at(0, s.camera()).position, vec3(0.0, 1.0, -5.0));
+    assert_eq!(script.camera_at(99, s.camera()).position, vec3(2.0, 1.0, -5.0));
+    let lights = script.lights_at(1, 10, s.lights(), s.light_paths());
     assert!((lights[0].position().unwrap() - vec3(1.5, 5.0, 1.0)).length() < 1e-6);
-    assert_eq!(script.lights_at(9, 10, &s.lights, &s.light_paths)[0].position(), Some(vec3(3.0, 5.0, 1.0)));
+    assert_eq!(script.lights_at(9, 10, s.lights(), s.light_paths())[0].position(), Some(vec3(3.0, 5.0, 1.0)));
 }
 
 #[test]
 fn scene_keyframes_play_the_scenes_own_light_paths_over_the_frames() {
     let s = scene();
     let script = parse("scene_keyframes = true", &s).unwrap();
-    let path = s.light_paths[0].as_ref().unwrap();
+    let path = s.light_paths()[0].as_ref().unwrap();
     for (frame, time) in [(0, 0.0), (2, 0.5), (4, 1.0)] {
-        let p = script.lights_at(frame, 5, &s.lights, &s.light_paths)[0].position().unwrap();
+        let p = script.lights_at(frame, 5, s.lights(), s.light_paths())[0].position().unwrap();
         // A quad light moves by its corner, so its centre comes back rounded.
         assert!((p - path.at(time)).length() < 1e-5, "frame {frame}: {p}");
     }

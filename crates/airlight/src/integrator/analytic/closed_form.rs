@@ -4,7 +4,7 @@
 //! parameter of the foot of the perpendicular from P to the ray's line and
 //! p = |P − o − h·d| the light's distance from that line (Packard 2004,
 //! "Efficient Rendering of Glowing Lights", the seed
-//! `packard-2004-glowing-lights.txt`). With y = t − h, the distance to the
+//! 2004). With y = t − h, the distance to the
 //! light is r(t) = √(p² + y²). For an isotropic light of intensity I in a
 //! homogeneous medium the single-scattered radiance over t in [t₀, t₁] is
 //!

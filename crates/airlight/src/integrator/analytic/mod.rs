@@ -1,5 +1,5 @@
 //! Closed-form single-scatter airlight (issue 4), after Packard 2004 (the
-//! seed `packard-2004-glowing-lights.txt`) and Sun, Ramamoorthi, Narasimhan
+//! seed: Packard, "Efficient Rendering of Glowing Lights", 2004) and Sun, Ramamoorthi, Narasimhan
 //! and Nayar 2005.
 //!
 //! Along a camera ray o + t·d the radiance is the surface term attenuated
@@ -84,19 +84,17 @@ use lights::Extended;
 use modulation::MediumConsts;
 use shadows::{in_intervals, visible};
 
-use super::{Integrator, surface_radiance};
+use super::{Integrator, IntegratorError, IntegratorKind, no_extra, single_scattering};
 use crate::Rgb;
 use crate::geometry::Ray;
 use crate::light::{AttenuationModel, Light, SpotProfile};
 use crate::medium::{Density, Medium};
 use crate::sampling::Sampler;
-use crate::scene::{RenderSettings, Scene};
+use crate::scene::Scene;
 use glam::{DVec3, Vec3};
-use serde::Deserialize;
 
 /// How the points of a line or quad light are placed.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, Deserialize)]
-#[serde(rename_all = "lowercase")]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum LightQuadrature {
     /// Gauss–Legendre nodes and weights along each edge.
     #[default]
@@ -114,9 +112,14 @@ pub struct AnalyticOptions {
     pub quadrature: LightQuadrature,
 }
 
-impl AnalyticOptions {
-    pub fn from_settings(s: &RenderSettings) -> Self {
-        AnalyticOptions { shadows: s.shadows, light_steps: s.light_steps, quadrature: s.light_quadrature }
+impl std::str::FromStr for LightQuadrature {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "gauss" => Ok(LightQuadrature::Gauss),
+            "uniform" => Ok(LightQuadrature::Uniform),
+            _ => Err(format!("unknown light quadrature `{s}`; expected gauss or uniform")),
+        }
     }
 }
 
@@ -183,13 +186,13 @@ impl Analytic {
     /// in a medium, non-physical attenuation models, and SDF objects with
     /// shadows are refused (see the module documentation).
     pub fn new(scene: &Scene, options: AnalyticOptions) -> Result<Analytic, String> {
-        let in_medium = scene.medium.as_ref().is_some_and(|m| m.sigma_s != Rgb::ZERO);
-        if options.shadows && scene.geometry.has_sdf() {
+        let in_medium = scene.medium().is_some_and(|m| m.sigma_s != Rgb::ZERO);
+        if options.shadows && scene.geometry().has_sdf() {
             return Err("the analytic integrator finds no exact shadow boundaries for SDF objects: \
                         use raymarch or stochastic, or render without shadows"
                 .into());
         }
-        if let Some(m) = &scene.medium
+        if let Some(m) = scene.medium()
             && let Density::Height { .. } = m.density
         {
             return Err("the analytic integrator needs a homogeneous medium; \
@@ -206,7 +209,7 @@ impl Analytic {
         };
         let mut emitters = Vec::new();
         let mut extended = Vec::new();
-        for (i, light) in scene.lights.iter().enumerate() {
+        for (i, light) in scene.lights().iter().enumerate() {
             let index = i as u32;
             if let Some(a) = light.attenuation()
                 && a.model != AttenuationModel::Physical
@@ -294,7 +297,7 @@ impl Analytic {
         }
         emitters.retain(|e| e.intensity != DVec3::ZERO);
         extended.retain(|e| e.intensity() != DVec3::ZERO);
-        let (blockers, meshes) = blockers::blockers(&scene.geometry);
+        let (blockers, meshes) = blockers::blockers(scene.geometry());
         Ok(Analytic { options, emitters, extended, rule, blockers, meshes })
     }
 
@@ -439,20 +442,15 @@ struct Scratch {
 
 impl Integrator for Analytic {
     fn radiance(&self, scene: &Scene, ray: &Ray, sampler: &mut Sampler) -> Rgb {
-        let hit = scene.geometry.intersect(ray, f32::INFINITY);
-        let (surface, t_end) = match hit {
-            Some(hit) => {
-                let s = scene.geometry.surface(ray, hit);
-                (surface_radiance(scene, ray, &s, sampler, scene.medium.as_ref()), hit.t)
-            }
-            None => (scene.settings.background, scene.settings.max_distance),
-        };
-        let Some(medium) = &scene.medium else {
-            return surface;
-        };
-        let through = medium.transmittance(ray.origin, ray.dir, 0.0, t_end);
-        // As raymarch: the medium is integrated up to max_distance at most.
-        let end = t_end.min(scene.settings.max_distance);
-        surface * through + self.in_scattered(scene, medium, ray, end)
+        single_scattering(scene, ray, sampler, no_extra, |medium, length, _| {
+            self.in_scattered(scene, medium, ray, length)
+        })
+    }
+
+    /// Emitters and blockers are placed where the lights are: rebuilt.
+    fn lights_changed(&mut self, scene: &Scene) -> Result<(), IntegratorError> {
+        *self = Analytic::new(scene, self.options)
+            .map_err(|reason| IntegratorError::Unsupported { integrator: IntegratorKind::Analytic, reason })?;
+        Ok(())
     }
 }

@@ -149,7 +149,7 @@ pub(super) fn visible(scene: &Scene, x: DVec3, e: &PointEmitter) -> bool {
     if reach.is_nan() || reach <= 0.0 {
         return true;
     }
-    !scene.geometry.occluded(x.as_vec3(), (to / dist).as_vec3(), reach as f32)
+    !scene.geometry().occluded(x.as_vec3(), (to / dist).as_vec3(), reach as f32)
 }
 
 #[cfg(test)]

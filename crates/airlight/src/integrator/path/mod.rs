@@ -11,7 +11,7 @@
 mod nee;
 pub mod tracking;
 
-use super::Integrator;
+use super::{Integrator, PathOptions};
 use crate::Rgb;
 use crate::geometry::{Ray, offset_origin};
 use crate::medium::{henyey_greenstein, sample_henyey_greenstein_cos};
@@ -33,8 +33,8 @@ pub struct PathTracer {
 }
 
 impl PathTracer {
-    pub fn new(max_depth: u32) -> Self {
-        PathTracer { max_depth, equiangular: true }
+    pub fn new(options: PathOptions) -> Self {
+        PathTracer { max_depth: options.max_depth, equiangular: true }
     }
 }
 
@@ -59,15 +59,15 @@ fn avg(v: Rgb) -> f32 {
 
 impl Integrator for PathTracer {
     fn radiance(&self, scene: &Scene, camera_ray: &Ray, sampler: &mut Sampler) -> Rgb {
-        let medium = scene.medium.as_ref().filter(|m| !m.is_vacuum());
-        let max_distance = scene.settings.max_distance;
+        let medium = scene.medium();
+        let max_distance = scene.settings().max_distance;
         let hero = ((sampler.next() * 3.0) as usize).min(2);
         let (mut l, mut beta, mut r_u, mut r_l) = (Rgb::ZERO, Rgb::ONE, Rgb::ONE, Rgb::ONE);
         let mut depth = 0u32;
         let mut ray = *camera_ray;
         let mut prev_p = ray.origin;
         loop {
-            let hit = scene.geometry.intersect(&ray, f32::INFINITY);
+            let hit = scene.geometry().intersect(&ray, f32::INFINITY);
             let t_hit = hit.map_or(f32::INFINITY, |h| h.t);
             if let Some(m) = medium {
                 // The medium scatters within max_distance along a ray (as the
@@ -149,12 +149,12 @@ impl Integrator for PathTracer {
             }
             let Some(hit) = hit else {
                 // Escaped: the background, which nothing samples directly.
-                l += beta * scene.settings.background / avg(r_u);
+                l += beta * scene.settings().background / avg(r_u);
                 return l;
             };
-            let surface = scene.geometry.surface(&ray, hit);
+            let surface = scene.geometry().surface(&ray, hit);
             if let Some(index) = surface.emitter {
-                let light = &scene.lights[index as usize];
+                let light = &scene.lights()[index as usize];
                 let le = light.emitted(surface.n, ray.dir);
                 if le != Rgb::ZERO {
                     if depth == 0 {
@@ -174,7 +174,7 @@ impl Integrator for PathTracer {
                 return l;
             }
             depth += 1;
-            let material = &scene.materials[surface.material as usize];
+            let material = scene.material_at(&surface);
             let wo = -ray.dir;
             let vertex = Vertex::Surface { p: surface.p, n: surface.n, material: surface.material };
             l += beta * direct_light(scene, medium, &vertex, wo, r_u, hero, sampler);

@@ -79,7 +79,7 @@ pub(super) fn equiangular_light(
     let key = sampler.next_key();
     let wo = -segment.ray.dir;
     let mut total = Rgb::ZERO;
-    for (index, light) in scene.lights.iter().enumerate() {
+    for (index, light) in scene.lights().iter().enumerate() {
         let Some(equiangular) = segment.equiangular(light) else { continue };
         if light.reach().is_some_and(|(center, radius)| !segment.passes_within(center, radius)) {
             continue;
@@ -141,7 +141,7 @@ pub(super) fn direct_light(
         let Some(ls) = light.sample(p, keyed2(key, index as u64)) else { return };
         let (f, scatter_pdf, origin) = match *vertex {
             Vertex::Surface { p, n, material } => {
-                let m = &scene.materials[material as usize];
+                let m = scene.material(material);
                 let f = m.brdf(p, n, wo, ls.wi) * ls.wi.dot(n).abs();
                 (f, m.pdf(p, n, wo, ls.wi), offset_origin(p, n, ls.wi))
             }

@@ -1,11 +1,49 @@
 //! Images: linear f32 RGB, written as EXR (linear) or PNG (sRGB after
-//! exposure and a tone curve), always whole or not at all; and the error
-//! measures that `airlight compare` prints.
+//! exposure and a tone curve), always whole or not at all; the accumulator
+//! that every render adds its samples into; and the error measures that
+//! `airlight compare` prints.
+
+mod accumulator;
+mod compare;
+
+pub use accumulator::{ACCUMULATOR_BYTES_PER_PIXEL, Accumulator, PixelSum, SQUARE_FRACTION_BITS, SUM_FRACTION_BITS};
+pub use compare::{ImageError, compare, error_map};
 
 use crate::Rgb;
-use crate::scene::Tonemap;
 use std::io;
 use std::path::{Path, PathBuf};
+
+/// How the image is turned into 8-bit PNG values (EXR output is always linear).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Tonemap {
+    /// Clip to [0, 1].
+    #[default]
+    Clamp,
+    /// The ACES filmic curve as fitted by Narkowicz (2015).
+    Filmic,
+}
+
+impl Tonemap {
+    pub const ALL: [Tonemap; 2] = [Tonemap::Clamp, Tonemap::Filmic];
+
+    /// The name a scene file gives it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Tonemap::Clamp => "clamp",
+            Tonemap::Filmic => "filmic",
+        }
+    }
+}
+
+impl std::str::FromStr for Tonemap {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        Tonemap::ALL
+            .into_iter()
+            .find(|t| t.name() == s)
+            .ok_or_else(|| format!("unknown tone curve `{s}`; expected clamp or filmic"))
+    }
+}
 
 /// A linear RGB image, row-major, pixel (0, 0) at the top-left.
 #[derive(Clone, Debug, PartialEq)]
@@ -31,11 +69,17 @@ impl Image {
         (sum / self.pixels.len().max(1) as f64).as_vec3()
     }
 
-    /// Writes `.exr` (linear f32) or `.png` (8-bit sRGB after exposure and
-    /// tone curve), chosen by the extension. The file is written beside the
-    /// target under a temporary name and renamed, so a failure never leaves
-    /// a partial image.
-    pub fn write(&self, path: &Path, exposure: f32, tonemap: Tonemap) -> io::Result<()> {
+    /// Writes `.exr` (linear f32) or `.png` (8-bit sRGB, clipped to [0, 1]),
+    /// chosen by the extension, whole or not at all (see [`Image::save_with`]).
+    pub fn save(&self, path: impl AsRef<Path>) -> io::Result<()> {
+        self.save_with(path.as_ref(), 0.0, Tonemap::Clamp)
+    }
+
+    /// Writes `.exr` (linear f32) or `.png` (8-bit sRGB after `exposure`
+    /// stops and the tone curve), chosen by the extension. The file is
+    /// written beside the target under a temporary name and renamed, so a
+    /// failure never leaves a partial image.
+    pub fn save_with(&self, path: &Path, exposure: f32, tonemap: Tonemap) -> io::Result<()> {
         let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
         let bytes = match ext.as_deref() {
             Some("exr") => self.encode_exr()?,
@@ -137,68 +181,6 @@ pub fn write_atomically(path: &Path, bytes: &[u8]) -> io::Result<()> {
     result
 }
 
-/// Differences between an image and a reference, over all pixels and channels.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct ImageError {
-    /// √(mean (a − b)²)
-    pub rmse: f64,
-    /// mean (a − b)² / (b² + 0.01): the relative MSE of Rousselle, Knaus and
-    /// Zwicker (2011), ε = 0.01 keeping dark pixels from dominating.
-    pub rel_mse: f64,
-    /// mean |a − b|
-    pub mae: f64,
-    /// max |a − b|
-    pub max: f64,
-    /// √(Σ (a − b)² / Σ b²): the RMSE relative to the reference's RMS. The
-    /// "relative RMSE" that tests and benchmarks quote.
-    pub rel_rmse: f64,
-}
-
-/// Compares `image` against `reference`; None if their sizes differ.
-pub fn compare(image: &Image, reference: &Image) -> Option<ImageError> {
-    if image.width != reference.width || image.height != reference.height {
-        return None;
-    }
-    let (mut se, mut rel, mut abs, mut max, mut ref2) = (0.0f64, 0.0f64, 0.0f64, 0.0f64, 0.0f64);
-    for (a, b) in image.pixels.iter().zip(&reference.pixels) {
-        for c in 0..3 {
-            let (a, b) = (a[c] as f64, b[c] as f64);
-            let d = a - b;
-            se += d * d;
-            rel += d * d / (b * b + 0.01);
-            abs += d.abs();
-            max = max.max(d.abs());
-            ref2 += b * b;
-        }
-    }
-    let n = (image.pixels.len() * 3).max(1) as f64;
-    Some(ImageError {
-        rmse: (se / n).sqrt(),
-        rel_mse: rel / n,
-        mae: abs / n,
-        max,
-        rel_rmse: if ref2 > 0.0 {
-            (se / ref2).sqrt()
-        } else if se == 0.0 {
-            0.0
-        } else {
-            f64::INFINITY
-        },
-    })
-}
-
-/// An error map: |a − b| averaged over channels, scaled so that `scale`
-/// maps to white.
-pub fn error_map(image: &Image, reference: &Image, scale: f32) -> Image {
-    let pixels = image
-        .pixels
-        .iter()
-        .zip(&reference.pixels)
-        .map(|(a, b)| Rgb::splat(((*a - *b).abs().element_sum() / 3.0) / scale.max(1e-30)))
-        .collect();
-    Image { width: image.width, height: image.height, pixels }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -211,7 +193,7 @@ mod tests {
         }
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("a.exr");
-        img.write(&path, 0.0, Tonemap::Clamp).unwrap();
+        img.save(&path).unwrap();
         assert_eq!(Image::read_exr(&path).unwrap(), img);
         // Nothing temporary is left behind.
         assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
@@ -221,9 +203,9 @@ mod tests {
     fn a_failed_write_leaves_no_file() {
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("missing-dir").join("a.png");
-        assert!(Image::new(2, 2).write(&path, 0.0, Tonemap::Clamp).is_err());
+        assert!(Image::new(2, 2).save(&path).is_err());
         assert!(!path.exists());
-        assert!(Image::new(2, 2).write(&dir.path().join("a.tiff"), 0.0, Tonemap::Clamp).is_err());
+        assert!(Image::new(2, 2).save(dir.path().join("a.tiff")).is_err());
         assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
     }
 
@@ -234,18 +216,5 @@ mod tests {
         // 0.5 linear is 0.7354 in sRGB: 187.5 → 188.
         assert_eq!(to_srgb8(0.5), 188);
         assert!(tone(1e6, Tonemap::Filmic) <= 1.0);
-    }
-
-    #[test]
-    fn compare_measures_known_differences() {
-        let a = Image { width: 2, height: 1, pixels: vec![Rgb::splat(1.0), Rgb::splat(0.0)] };
-        let b = Image { width: 2, height: 1, pixels: vec![Rgb::splat(1.0), Rgb::splat(0.5)] };
-        let e = compare(&a, &b).unwrap();
-        assert!((e.rmse - (0.125f64).sqrt()).abs() < 1e-12);
-        assert!((e.mae - 0.25).abs() < 1e-12);
-        assert_eq!(e.max, 0.5);
-        assert!((e.rel_mse - 0.5 * 0.25 / 0.26).abs() < 1e-12);
-        assert!((e.rel_rmse - (0.75f64 / 3.75).sqrt()).abs() < 1e-12);
-        assert!(compare(&a, &Image::new(1, 1)).is_none());
     }
 }

@@ -1,0 +1,326 @@
+//! The one accumulator under every render: per pixel the sum and the sum of
+//! squares of its samples and their count.
+//!
+//! Sums are kept in fixed point (`i128`), not floating point: each sample is
+//! rounded once to a multiple of 2⁻⁴⁸ (its square to a multiple of 2⁻⁶⁴)
+//! and integers add exactly, in any order. So the same samples give the
+//! same bits however they were grouped: one render, progressive passes,
+//! sample shards rendered on other machines and merged, tiles. A floating
+//! point sum would differ in its last bits with the grouping.
+//!
+//! Range and precision: a sum holds up to 2⁷⁹ ≈ 6·10²³ (radiance times
+//! samples), a sum of squares 2⁶³ ≈ 9·10¹⁸; beyond, the sums saturate
+//! instead of wrapping (only the variance of pixels with single samples
+//! above 3·10⁹ is affected). The rounding of a sample, at most 1.8·10⁻¹⁵,
+//! is far below f32's own resolution for the radiance of any visible pixel.
+
+use crate::Rgb;
+use crate::film::Image;
+use glam::DVec3;
+
+/// Fraction bits of a sample in [`PixelSum::sum`].
+pub const SUM_FRACTION_BITS: i32 = 48;
+/// Fraction bits of a squared sample in [`PixelSum::sum_squares`].
+pub const SQUARE_FRACTION_BITS: i32 = 64;
+
+/// One pixel's samples: fixed-point sums per channel and how many.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub struct PixelSum {
+    /// Σ x · 2⁴⁸, each term rounded to an integer.
+    pub sum: [i128; 3],
+    /// Σ x² · 2⁶⁴, each term rounded to an integer.
+    pub sum_squares: [i128; 3],
+    /// Samples taken, broken ones (NaN, infinite) included: they count as
+    /// zero, so that one broken sample does not bias the pixel upward.
+    pub count: u64,
+}
+
+/// `x · 2^bits` rounded to the nearest integer; saturates at the ends of
+/// `i128` (Rust's float-to-int cast does), so no input overflows.
+#[inline]
+fn to_fixed(x: f64, bits: i32) -> i128 {
+    (x * 2f64.powi(bits)).round() as i128
+}
+
+#[inline]
+fn from_fixed(x: i128, bits: i32) -> f64 {
+    x as f64 * 2f64.powi(-bits)
+}
+
+impl PixelSum {
+    /// Adds one sample. Non-finite samples count but add nothing.
+    #[inline]
+    pub fn add(&mut self, sample: Rgb) {
+        self.count += 1;
+        if !sample.is_finite() {
+            return;
+        }
+        for (c, x) in sample.to_array().into_iter().enumerate() {
+            // f32 → f64 is exact, and so is the square of an f32 in f64
+            // (24 + 24 bits of mantissa fit in 53).
+            let x = x as f64;
+            self.sum[c] = self.sum[c].saturating_add(to_fixed(x, SUM_FRACTION_BITS));
+            self.sum_squares[c] = self.sum_squares[c].saturating_add(to_fixed(x * x, SQUARE_FRACTION_BITS));
+        }
+    }
+
+    /// Adds another pixel's samples (exact, in any order).
+    #[inline]
+    pub fn merge(&mut self, other: &PixelSum) {
+        for c in 0..3 {
+            self.sum[c] = self.sum[c].saturating_add(other.sum[c]);
+            self.sum_squares[c] = self.sum_squares[c].saturating_add(other.sum_squares[c]);
+        }
+        self.count += other.count;
+    }
+
+    /// The mean of the samples (black before the first).
+    pub fn mean(&self) -> Rgb {
+        self.mean_f64().as_vec3()
+    }
+
+    fn mean_f64(&self) -> DVec3 {
+        if self.count == 0 {
+            return DVec3::ZERO;
+        }
+        let n = self.count as f64;
+        DVec3::from_array(self.sum.map(|s| from_fixed(s, SUM_FRACTION_BITS) / n))
+    }
+
+    /// The estimated variance of the pixel's mean, per channel: s²/n with
+    /// s² = (Σx² − (Σx)²/n)/(n − 1), the unbiased sample variance. Exact in
+    /// expectation for independent samples, an upper bound for stratified
+    /// ones (stratification only lowers the variance of the mean). Infinite
+    /// before two samples.
+    pub fn variance_of_mean(&self) -> DVec3 {
+        if self.count < 2 {
+            return DVec3::INFINITY;
+        }
+        let n = self.count as f64;
+        let sum = DVec3::from_array(self.sum.map(|s| from_fixed(s, SUM_FRACTION_BITS)));
+        let squares = DVec3::from_array(self.sum_squares.map(|s| from_fixed(s, SQUARE_FRACTION_BITS)));
+        let sample_variance = ((squares - sum * sum / n) / (n - 1.0)).max(DVec3::ZERO);
+        sample_variance / n
+    }
+}
+
+/// The samples of a band of rows of an image (all rows by default): a
+/// [`PixelSum`] per pixel, in rows of the full image's width.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Accumulator {
+    width: u32,
+    height: u32,
+    /// The band of rows held, `first_row .. first_row + pixels.len() / width`.
+    first_row: u32,
+    pixels: Vec<PixelSum>,
+}
+
+/// Bytes an [`Accumulator`] holds per pixel.
+pub const ACCUMULATOR_BYTES_PER_PIXEL: usize = size_of::<PixelSum>();
+
+impl Accumulator {
+    /// An empty accumulator for a whole `width` × `height` image.
+    pub fn new(width: u32, height: u32) -> Self {
+        Self::band(width, height, 0..height)
+    }
+
+    /// An empty accumulator for the rows `rows` of a `width` × `height`
+    /// image (clipped to the image).
+    pub fn band(width: u32, height: u32, rows: std::ops::Range<u32>) -> Self {
+        let first_row = rows.start.min(height);
+        let end = rows.end.clamp(first_row, height);
+        let pixels = vec![PixelSum::default(); width as usize * (end - first_row) as usize];
+        Accumulator { width, height, first_row, pixels }
+    }
+
+    /// The full image's size.
+    pub fn size(&self) -> (u32, u32) {
+        (self.width, self.height)
+    }
+
+    /// The rows held.
+    pub fn rows(&self) -> std::ops::Range<u32> {
+        let count = (self.pixels.len() as u32).checked_div(self.width).unwrap_or(0);
+        self.first_row..self.first_row + count
+    }
+
+    /// The pixels held, row by row from the first row held.
+    pub fn pixels(&self) -> &[PixelSum] {
+        &self.pixels
+    }
+
+    pub fn pixels_mut(&mut self) -> &mut [PixelSum] {
+        &mut self.pixels
+    }
+
+    /// The sum of pixel (x, y) of the full image, if its row is held.
+    pub fn pixel(&self, x: u32, y: u32) -> Option<&PixelSum> {
+        if x >= self.width || !self.rows().contains(&y) {
+            return None;
+        }
+        self.pixels.get(((y - self.first_row) * self.width + x) as usize)
+    }
+
+    pub fn pixel_mut(&mut self, x: u32, y: u32) -> Option<&mut PixelSum> {
+        if x >= self.width || !self.rows().contains(&y) {
+            return None;
+        }
+        self.pixels.get_mut(((y - self.first_row) * self.width + x) as usize)
+    }
+
+    /// Adds `other`'s samples into the rows both hold. Fails, changing
+    /// nothing, when the images' sizes differ or `other` holds rows this
+    /// one does not.
+    pub fn merge(&mut self, other: &Accumulator) -> Result<(), String> {
+        if self.size() != other.size() {
+            return Err(format!(
+                "the images differ in size: {}×{} and {}×{}",
+                self.width, self.height, other.width, other.height
+            ));
+        }
+        let (mine, theirs) = (self.rows(), other.rows());
+        if theirs.start < mine.start || theirs.end > mine.end {
+            return Err(format!("rows {theirs:?} do not lie within rows {mine:?}"));
+        }
+        let offset = ((theirs.start - mine.start) * self.width) as usize;
+        for (a, b) in self.pixels[offset..].iter_mut().zip(&other.pixels) {
+            a.merge(b);
+        }
+        Ok(())
+    }
+
+    /// The smallest and largest sample count of any pixel held.
+    pub fn count_range(&self) -> (u64, u64) {
+        let min = self.pixels.iter().map(|p| p.count).min().unwrap_or(0);
+        let max = self.pixels.iter().map(|p| p.count).max().unwrap_or(0);
+        (min, max)
+    }
+
+    /// The mean of each pixel's samples; rows not held are black.
+    pub fn image(&self) -> Image {
+        self.map(PixelSum::mean)
+    }
+
+    /// The estimated variance of each pixel's mean, per channel (see
+    /// [`PixelSum::variance_of_mean`]); rows not held are black.
+    pub fn variance(&self) -> Image {
+        self.map(|p| p.variance_of_mean().as_vec3())
+    }
+
+    fn map(&self, f: impl Fn(&PixelSum) -> Rgb) -> Image {
+        let mut image = Image::new(self.width, self.height);
+        let start = (self.first_row * self.width) as usize;
+        for (out, p) in image.pixels[start..].iter_mut().zip(&self.pixels) {
+            *out = f(p);
+        }
+        image
+    }
+
+    /// The estimated relative error of the image: √(Σ Var(mean) / Σ mean²)
+    /// over pixels and channels, what [`crate::film::compare`]'s `rel_rmse`
+    /// against the converged image is expected to be. Infinite before two
+    /// samples in every pixel, or for a black image.
+    pub fn estimated_relative_error(&self) -> f64 {
+        let (mut variance, mut signal) = (0.0, 0.0);
+        for p in &self.pixels {
+            variance += p.variance_of_mean().element_sum();
+            signal += p.mean_f64().length_squared();
+        }
+        if signal > 0.0 && variance.is_finite() { (variance / signal).sqrt() } else { f64::INFINITY }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn samples(n: usize) -> Vec<Rgb> {
+        // Values over many octaves, as a renderer's samples are.
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        (0..n)
+            .map(|_| {
+                state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+                let u = (state >> 40) as f32 / (1u64 << 24) as f32;
+                let octave = ((state >> 8) % 30) as i32 - 20;
+                Rgb::new(u * 2f32.powi(octave), u, 1.0 - u)
+            })
+            .collect()
+    }
+
+    #[test]
+    fn the_sum_does_not_depend_on_how_samples_are_grouped() {
+        let xs = samples(1000);
+        let mut whole = PixelSum::default();
+        for &x in &xs {
+            whole.add(x);
+        }
+        // Reversed, and in uneven chunks merged in another order.
+        let mut reversed = PixelSum::default();
+        for &x in xs.iter().rev() {
+            reversed.add(x);
+        }
+        assert_eq!(whole, reversed);
+        let mut parts: Vec<PixelSum> = xs
+            .chunks(37)
+            .map(|chunk| {
+                let mut p = PixelSum::default();
+                chunk.iter().for_each(|&x| p.add(x));
+                p
+            })
+            .collect();
+        parts.reverse();
+        let mut merged = PixelSum::default();
+        for p in &parts {
+            merged.merge(p);
+        }
+        assert_eq!(whole, merged);
+        assert_eq!(whole.mean().to_array().map(f32::to_bits), merged.mean().to_array().map(f32::to_bits));
+    }
+
+    #[test]
+    fn mean_and_variance_match_a_direct_f64_computation() {
+        let xs = samples(500);
+        let mut p = PixelSum::default();
+        xs.iter().for_each(|&x| p.add(x));
+        let n = xs.len() as f64;
+        let mean: DVec3 = xs.iter().map(|x| x.as_dvec3()).sum::<DVec3>() / n;
+        let var: DVec3 = xs.iter().map(|x| (x.as_dvec3() - mean) * (x.as_dvec3() - mean)).sum::<DVec3>() / (n - 1.0);
+        let got = p.mean().as_dvec3();
+        assert!(((got - mean) / mean).abs().max_element() < 1e-6, "{got} vs {mean}");
+        let got = p.variance_of_mean();
+        assert!(((got - var / n) / (var / n)).abs().max_element() < 1e-6, "{got} vs {}", var / n);
+    }
+
+    #[test]
+    fn broken_samples_count_as_zero_and_huge_ones_saturate() {
+        let mut p = PixelSum::default();
+        p.add(Rgb::splat(2.0));
+        p.add(Rgb::new(f32::NAN, f32::INFINITY, 2.0));
+        assert_eq!(p.count, 2);
+        // A sample with any broken channel is dropped whole.
+        assert_eq!(p.mean(), Rgb::splat(1.0));
+        let mut big = PixelSum::default();
+        for _ in 0..4 {
+            big.add(Rgb::splat(f32::MAX));
+        }
+        assert_eq!(big.sum[0], i128::MAX);
+        assert!(big.mean().is_finite());
+        assert_eq!(PixelSum::default().mean(), Rgb::ZERO);
+        assert!(PixelSum::default().variance_of_mean().x.is_infinite());
+    }
+
+    #[test]
+    fn bands_merge_into_the_rows_they_hold() {
+        let mut whole = Accumulator::new(3, 4);
+        let mut band = Accumulator::band(3, 4, 1..3);
+        band.pixel_mut(2, 2).unwrap().add(Rgb::splat(4.0));
+        assert!(band.pixel(0, 0).is_none());
+        whole.merge(&band).unwrap();
+        assert_eq!(whole.image().pixel(2, 2), Rgb::splat(4.0));
+        assert_eq!(whole.count_range(), (0, 1));
+        assert!(band.merge(&whole).is_err(), "a band cannot take rows it does not hold");
+        assert!(whole.merge(&Accumulator::new(3, 5)).is_err());
+        assert_eq!(band.image().pixel(2, 2), Rgb::splat(4.0));
+        assert_eq!(band.image().pixel(0, 0), Rgb::ZERO);
+    }
+}

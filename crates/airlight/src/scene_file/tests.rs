@@ -1,0 +1,82 @@
+use super::*;
+use crate::prelude::*;
+use crate::render::{RenderObserver, render};
+use glam::Affine3A;
+
+const SCENE: &str = r#"
+[render]
+width = 24
+height = 16
+spp = 2
+integrator = "direct"
+
+[camera]
+position = [0, 2, -6]
+look_at = [0, 1, 0]
+fov = 40
+
+[materials.floor]
+type = "checker"
+albedo = 0.8
+albedo2 = 0.2
+scale = 1
+
+[materials.ball]
+type = "phong"
+albedo = [0.2, 0.4, 0.9]
+specular = 0.1
+exponent = 20
+
+[[objects]]
+type = "plane"
+point = [0, 0, 0]
+normal = [0, 1, 0]
+material = "floor"
+
+[[objects]]
+type = "sphere"
+center = [0, 0, 0]
+radius = 1
+translate = [0, 1, 0]
+material = "ball"
+
+[[lights]]
+type = "spot"
+position = [0, 5, 0]
+look_at = [0, 0, 0]
+intensity = 40
+cone_angle = 30
+falloff_start = 25
+"#;
+
+#[test]
+fn file_and_builder_make_the_same_scene() {
+    let from_file = SceneFile::from_toml_str(SCENE, None).unwrap();
+    let built = SceneBuilder::new()
+        .size(24, 16)
+        .with_settings(|s| s.spp = 2)
+        .camera(Camera::look_at(vec3(0.0, 2.0, -6.0), vec3(0.0, 1.0, 0.0), Vec3::Y, 40.0))
+        .material("floor", Material::checker(Rgb::splat(0.8), Rgb::splat(0.2), 1.0))
+        .material("ball", Material::phong(Rgb::new(0.2, 0.4, 0.9), Rgb::splat(0.1), 20.0))
+        .object(Shape::plane(Vec3::ZERO, Vec3::Y), "floor")
+        .object_transformed(Shape::sphere(Vec3::ZERO, 1.0), Affine3A::from_translation(Vec3::Y), "ball")
+        .light(Light::spot(vec3(0.0, 5.0, 0.0), Vec3::ZERO, Rgb::splat(40.0), 30.0, 25.0))
+        .build()
+        .unwrap();
+    assert_eq!(from_file.integrator, IntegratorDesc::new(IntegratorKind::Direct));
+    let from_file = from_file.scene;
+    assert_eq!(from_file.settings(), built.settings());
+    assert_eq!(from_file.lights(), built.lights());
+    let integrator = IntegratorDesc::default().build(&built).unwrap();
+    let a = render(&from_file, integrator.as_ref(), &RenderObserver::none());
+    let b = render(&built, integrator.as_ref(), &RenderObserver::none());
+    assert!(a == b, "file and builder render differently");
+    assert!(a.mean().z > 0.0);
+}
+
+#[test]
+fn fog_without_an_integrator_named_is_ray_marched() {
+    let file = SceneFile::from_toml_str("[medium]\nsigma_s = 0.1\n", None).unwrap();
+    assert_eq!(file.integrator.kind, IntegratorKind::Raymarch);
+    assert_eq!(SceneFile::from_toml_str("", None).unwrap().integrator.kind, IntegratorKind::Direct);
+}
