@@ -8,7 +8,28 @@
 //! refuses such scenes rather than drop that light.
 
 use super::blockers::{Blocker, Shape};
+use super::triangles::MeshShadows;
+use crate::light::Light;
 use glam::DVec3;
+
+/// Refuses a sphere light whose ball a surface (other than its own) cuts
+/// through, naming it.
+pub(super) fn check_sphere_lights(lights: &[Light], blockers: &[Blocker], meshes: &MeshShadows) -> Result<(), String> {
+    for (i, light) in lights.iter().enumerate() {
+        let Light::Sphere { center, radius, .. } = *light else { continue };
+        let (c, r) = (center.as_dvec3(), radius as f64);
+        let cut = blockers.iter().any(|b| b.emitter != Some(i as u32) && b.surface_within(c, r))
+            || meshes.surface_within(c, r);
+        if cut {
+            return Err(format!(
+                "lights[{i}] is a sphere light that a surface cuts through; the analytic integrator \
+                 shadows a sphere light as a point at its centre, which would drop the light of the \
+                 part beyond the surface: use raymarch, or move the light clear of the surface"
+            ));
+        }
+    }
+    Ok(())
+}
 
 impl Blocker {
     /// Whether the occluder's surface comes closer than `radius` to `p`

@@ -95,7 +95,7 @@ use triangles::MeshShadows;
 
 use super::{Integrator, surface_radiance};
 use crate::Rgb;
-use crate::geometry::{Ray, Shape};
+use crate::geometry::Ray;
 use crate::light::{AttenuationModel, Light, SpotProfile};
 use crate::medium::{Density, Medium};
 use crate::sampling::Sampler;
@@ -302,21 +302,9 @@ impl Analytic {
         emitters.retain(|e| e.intensity != DVec3::ZERO);
         extended.retain(|e| e.intensity() != DVec3::ZERO);
         let blockers = blockers::blockers(&scene.geometry);
-        let meshes = if options.shadows { mesh_shadows(scene) } else { MeshShadows::default() };
+        let meshes = if options.shadows { MeshShadows::of_scene(scene) } else { MeshShadows::default() };
         if options.shadows {
-            for (i, light) in scene.lights.iter().enumerate() {
-                let Light::Sphere { center, radius, .. } = *light else { continue };
-                let (c, r) = (center.as_dvec3(), radius as f64);
-                let cut = blockers.iter().any(|b| b.emitter != Some(i as u32) && b.surface_within(c, r))
-                    || meshes.surface_within(c, r);
-                if cut {
-                    return Err(format!(
-                        "lights[{i}] is a sphere light that a surface cuts through; the analytic integrator \
-                         shadows a sphere light as a point at its centre, which would drop the light of the \
-                         part beyond the surface: use raymarch, or move the light clear of the surface"
-                    ));
-                }
-            }
+            clearance::check_sphere_lights(&scene.lights, &blockers, &meshes)?;
         }
         Ok(Analytic { options, emitters, extended, rule, blockers, meshes })
     }
@@ -444,31 +432,6 @@ impl Analytic {
         }
         sum * e.intensity
     }
-}
-
-/// The triangles of the scene's meshes, with their vertices as the meshes
-/// give them: two triangles that share an edge share its vertices exactly,
-/// so their shadows meet with no crack (the BVH's triangles keep an edge
-/// vector instead, rounded in f32).
-fn mesh_shadows(scene: &Scene) -> MeshShadows {
-    let mut triangles = Vec::new();
-    for (shape, _) in &scene.objects {
-        let baked;
-        let shape = match shape {
-            Shape::Transformed { shape, world_from_local } => {
-                baked = shape.as_ref().clone().transformed(*world_from_local);
-                &baked
-            }
-            other => other,
-        };
-        if let Shape::Mesh { positions, triangles: indices } = shape {
-            for tri in indices {
-                let vertices = tri.map(|i| positions.get(i as usize).copied().unwrap_or(Vec3::NAN).as_dvec3());
-                triangles.push(vertices);
-            }
-        }
-    }
-    MeshShadows::new(triangles)
 }
 
 #[derive(Default)]

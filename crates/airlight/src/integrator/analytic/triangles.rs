@@ -20,6 +20,8 @@
 //! normals and the coordinate axes).
 
 use super::clearance::triangle_distance;
+use crate::geometry::Shape;
+use crate::scene::Scene;
 use glam::DVec3;
 
 /// One triangle of a mesh, its vertices as the mesh gives them.
@@ -65,6 +67,30 @@ impl MeshShadows {
             build(&mut triangles, 0, 0, &mut nodes);
         }
         MeshShadows { triangles, nodes }
+    }
+
+    /// The triangles of the scene's meshes, with their vertices as the
+    /// meshes give them: two triangles that share an edge share its
+    /// vertices exactly, so their shadows meet with no crack (the BVH's
+    /// triangles keep edge vectors instead, rounded in f32).
+    pub fn of_scene(scene: &Scene) -> MeshShadows {
+        let mut triangles = Vec::new();
+        for (shape, _) in &scene.objects {
+            let baked;
+            let shape = match shape {
+                Shape::Transformed { shape, world_from_local } => {
+                    baked = shape.as_ref().clone().transformed(*world_from_local);
+                    &baked
+                }
+                other => other,
+            };
+            if let Shape::Mesh { positions, triangles: indices } = shape {
+                for tri in indices {
+                    triangles.push(tri.map(|i| positions.get(i as usize).map_or(DVec3::NAN, |p| p.as_dvec3())));
+                }
+            }
+        }
+        MeshShadows::new(triangles)
     }
 
     #[cfg(test)]
