@@ -27,6 +27,7 @@
 //! direct light. The diffuse albedo of a Phong material bounces; its specular
 //! lobe does not.
 
+pub mod enclosures;
 pub mod factors;
 pub mod hierarchy;
 pub mod lighting;
@@ -174,7 +175,8 @@ impl Radiosity {
             return Err(RadiosityError::TooManyPatches { patch_size: params.patch_size, estimated });
         }
         for (index, (shape, material)) in scene.objects.iter().enumerate() {
-            patches::cut(shape, *material, index as u32, params.patch_size, square, &mut patches);
+            let inner = enclosures::holds_light(shape, &scene.lights, &scene.light_paths);
+            patches::cut(shape, *material, index as u32, params.patch_size, square, inner, &mut patches);
         }
         let cut = start.elapsed();
 
@@ -250,7 +252,11 @@ impl Radiosity {
 
     /// The per-frame step with these `lights` (moved, dimmed: anything but
     /// the geometry may differ from the scene's) and the scene's materials:
-    /// direct light, then `bounces` × (push, gather).
+    /// direct light, then `bounces` × (push, gather). The inner sides of
+    /// boxes and spheres were patched when compiling for the scene's lights
+    /// inside them along their keyframe paths ([`enclosures`]); a light
+    /// moved into a closed shape that held none lights its inside directly,
+    /// with no bounce.
     pub fn update_with(&mut self, scene: &Scene, lights: &[Light], bounces: u32) -> FrameTimes {
         if self.materials != scene.materials {
             self.materials = scene.materials.clone();
