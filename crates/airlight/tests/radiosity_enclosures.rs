@@ -83,18 +83,51 @@ fn inside_a_sphere_every_patch_gathers_the_whole_sphere() {
 }
 
 #[test]
-fn an_ellipsoid_dome_is_patched_inside_too() {
-    // The sphere stretched and turned: the light at its centre still sees
-    // every inner patch, so all of them are kept and lit; the closed form
-    // no longer holds (the direct light varies), so only the count and the
-    // range are checked here.
-    let m = Affine3A::from_scale_rotation_translation(vec3(1.5, 1.0, 1.2), Quat::from_rotation_y(0.4), Vec3::ZERO);
-    let scene = pbrt_sphere(4, Some(m));
-    let r = Radiosity::compile(&scene).unwrap();
-    let inner = r.patches().iter().filter(|p| p.normal.dot(p.center) < 0.0).count();
-    let lit = r.indirect_irradiance().iter().filter(|e| e.x > 0.0).count();
-    println!("ellipsoid: {} patches, {inner} inner, {lit} with indirect light", r.patches().len());
-    assert!(inner > 1000 && lit >= inner);
+fn closed_shapes_conserve_the_light_inside_them() {
+    // A closed surface of one albedo ρ around a point light of intensity I
+    // catches all of its power Φ = 4πI, and each bounce passes on a
+    // fraction ρ of what it caught, all of it caught again: the patches'
+    // Σ A·E_direct = Φ and, after n bounces, Σ A·E_indirect = Φ (ρ + … +
+    // ρⁿ), whatever the shape. An ellipsoid (a turned, stretched sphere), a
+    // turned box and a closed mesh, the light off centre.
+    let turn = Quat::from_rotation_y(0.4) * Quat::from_rotation_x(0.2);
+    let shapes = [
+        (
+            "ellipsoid",
+            Shape::sphere(Vec3::ZERO, 1.0).transformed(Affine3A::from_scale_rotation_translation(
+                vec3(1.5, 1.0, 1.2),
+                turn,
+                Vec3::ZERO,
+            )),
+        ),
+        ("turned box", Shape::cuboid(Vec3::splat(-1.0), Vec3::ONE).transformed(Affine3A::from_quat(turn))),
+        ("mesh box", mesh_box(Vec3::splat(-1.0), Vec3::ONE)),
+    ];
+    let (albedo, intensity, bounces) = (0.5f32, 3.0f32, 4);
+    for (name, shape) in shapes {
+        let scene = SceneBuilder::new()
+            .material("m", Material::diffuse(Rgb::splat(albedo)))
+            .object(shape, "m")
+            .light(Light::point(vec3(0.2, -0.1, 0.15), Rgb::splat(intensity)))
+            .with_settings(|s| {
+                s.bounces = bounces;
+                s.patch_size = Some(0.15);
+            })
+            .build()
+            .unwrap();
+        let r = Radiosity::compile(&scene).unwrap();
+        let power = 4.0 * std::f64::consts::PI * intensity as f64;
+        let caught = |e: &[Rgb]| -> f64 { r.patches().iter().zip(e).map(|(p, e)| p.area as f64 * e.x as f64).sum() };
+        let direct = caught(r.direct_irradiance()) / power;
+        let indirect = caught(r.indirect_irradiance()) / power;
+        let exact: f64 = (1..=bounces).map(|k| (albedo as f64).powi(k as i32)).sum();
+        println!(
+            "{name}: {} patches; Σ A E_direct / Φ = {direct:.4} (1), Σ A E_indirect / Φ = {indirect:.4} ({exact:.4})",
+            r.patches().len()
+        );
+        assert!((direct - 1.0).abs() < 0.01, "{name}: direct {direct}");
+        assert!((indirect / exact - 1.0).abs() < 0.01, "{name}: indirect {indirect} vs {exact}");
+    }
 }
 
 /// What the room is made of.
