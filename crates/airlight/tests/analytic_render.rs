@@ -225,7 +225,7 @@ fn volumetric_shadows_match_raymarch_with_jitter() {
 }
 
 #[test]
-fn mesh_shadows_by_march_and_bisection_match_raymarch() {
+fn mesh_shadows_match_raymarch() {
     // A cube as twelve triangles, and a tilted box instance, under a point light.
     let cube = |c: Vec3, s: f32| {
         let positions: Vec<Vec3> = (0..8)

@@ -27,6 +27,7 @@
 //! direct light. The diffuse albedo of a Phong material bounces; its specular
 //! lobe does not.
 
+pub mod enclosures;
 pub mod factors;
 pub mod hierarchy;
 pub mod lighting;
@@ -192,7 +193,8 @@ impl Radiosity {
             return Err(RadiosityError::TooManyPatches { patch_size: params.patch_size, estimated });
         }
         for (index, (shape, material)) in scene.objects().iter().enumerate() {
-            patches::cut(shape, *material, index as u32, params.patch_size, square, &mut patches);
+            let inner = enclosures::holds_light(shape, scene.lights(), scene.light_paths());
+            patches::cut(shape, *material, index as u32, params.patch_size, square, inner, &mut patches);
         }
         let cut = start.elapsed();
 
@@ -268,7 +270,10 @@ impl Radiosity {
 
     /// The per-frame step with the scene's lights and materials (anything
     /// but the geometry may have changed since compiling): direct light,
-    /// then `bounces` × (push, gather).
+    /// then `bounces` × (push, gather). The inner sides of boxes and spheres
+    /// were patched when compiling for the scene's lights inside them along
+    /// their keyframe paths ([`enclosures`]); a light moved into a closed
+    /// shape that held none lights its inside directly, with no bounce.
     pub fn update(&mut self, scene: &Scene, bounces: u32) -> FrameTimes {
         if self.materials != scene.materials() {
             self.materials = scene.materials().to_vec();

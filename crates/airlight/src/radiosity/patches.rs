@@ -3,9 +3,10 @@
 //! A patch is one side of a small piece of surface: a parallelogram or a
 //! triangle with its centre, the unit normal of the side it stands for, its
 //! area and its material. Surfaces that enclose a solid (boxes, spheres) get
-//! patches on their outside only; open surfaces (quads, planes, meshes) are
-//! two-sided (docs/scene-format.md: every diffuse surface reflects on both sides), so
-//! each piece gives two patches, one per side.
+//! patches on their outside, and on their inside too when a light is
+//! inside them (a room, a dome: see [`super::enclosures`]); open surfaces
+//! (quads, planes, meshes) are two-sided (every diffuse surface reflects
+//! on both sides), so each piece gives two patches, one per side.
 //!
 //! Sizes: a quad is cut into ⌈|u|/h⌉ × ⌈|v|/h⌉ parallelograms, so no patch
 //! edge is longer than `h` = `patch_size`; a triangle into n² similar
@@ -85,9 +86,18 @@ pub struct Patch {
 }
 
 /// Appends the patches of `shape` (material `material`, object `object`),
-/// cut to size `h`. Planes are clipped to the square of [`plane_square`]
-/// around `center` with half side `half`.
-pub fn cut(shape: &Shape, material: u32, object: u32, h: f32, (center, half): (Vec3, f32), out: &mut Vec<Patch>) {
+/// cut to size `h`; a box or sphere gets inner sides too when `inner`.
+/// Planes are clipped to the square of [`plane_square`] around `center`
+/// with half side `half`.
+pub fn cut(
+    shape: &Shape,
+    material: u32,
+    object: u32,
+    h: f32,
+    (center, half): (Vec3, f32),
+    inner: bool,
+    out: &mut Vec<Patch>,
+) {
     let start = out.len();
     match shape {
         // Signed distance fields are not cut into patches (yet): they
@@ -98,8 +108,8 @@ pub fn cut(shape: &Shape, material: u32, object: u32, h: f32, (center, half): (V
             let (corner, u, v) = plane_square(*point, *normal, center, half);
             cut_quad(corner, u, v, h, true, out);
         }
-        Shape::Box { min, max } => cut_box(*min, *max, h, out),
-        Shape::Sphere { center, radius } => cut_sphere(*center, *radius, h, out),
+        Shape::Box { min, max } => cut_box(*min, *max, h, inner, out),
+        Shape::Sphere { center, radius } => cut_sphere(*center, *radius, h, inner, out),
         Shape::Mesh { positions, triangles } => {
             for tri in triangles {
                 let [a, b, c] = tri.map(|i| positions[i as usize]);
@@ -110,7 +120,7 @@ pub fn cut(shape: &Shape, material: u32, object: u32, h: f32, (center, half): (V
             let linear = Mat3::from(world_from_local.matrix3);
             let stretch = linear.x_axis.length().max(linear.y_axis.length()).max(linear.z_axis.length());
             let mut local = Vec::new();
-            cut(shape, material, object, h / stretch, (center, half), &mut local);
+            cut(shape, material, object, h / stretch, (center, half), inner, &mut local);
             out.extend(local.iter().map(|p| transform(p, *world_from_local)));
         }
     }
@@ -122,7 +132,7 @@ pub fn cut(shape: &Shape, material: u32, object: u32, h: f32, (center, half): (V
 
 /// How many patches [`cut`] makes of `shape` (without making them), so
 /// that a patch size far too small for the scene is refused before memory
-/// runs out.
+/// runs out; boxes and spheres are counted with both sides.
 pub fn count(shape: &Shape, h: f32, (center, half): (Vec3, f32)) -> f64 {
     let quad = |u: Vec3, v: Vec3| cells(u.length(), h) as f64 * cells(v.length(), h) as f64;
     match shape {
@@ -139,7 +149,7 @@ pub fn count(shape: &Shape, h: f32, (center, half): (Vec3, f32)) -> f64 {
         }
         Shape::Sphere { radius, .. } => {
             let bands = cells(PI * radius, h).max(2) as f64;
-            bands * (cells(2.0 * PI * radius, h).max(3) as f64)
+            2.0 * bands * (cells(2.0 * PI * radius, h).max(3) as f64)
         }
         Shape::Mesh { positions, triangles } => triangles
             .iter()
@@ -233,7 +243,7 @@ fn cut_quad(corner: Vec3, u: Vec3, v: Vec3, h: f32, two_sided: bool, out: &mut V
     }
 }
 
-fn cut_box(min: Vec3, max: Vec3, h: f32, out: &mut Vec<Patch>) {
+fn cut_box(min: Vec3, max: Vec3, h: f32, inner: bool, out: &mut Vec<Patch>) {
     let d = max - min;
     let (x, y, z) = (Vec3::X * d.x, Vec3::Y * d.y, Vec3::Z * d.z);
     // Each face as (corner, u, v) with u × v pointing outward.
@@ -246,7 +256,7 @@ fn cut_box(min: Vec3, max: Vec3, h: f32, out: &mut Vec<Patch>) {
         (min + z, x, y), // +z
     ];
     for (corner, u, v) in faces {
-        cut_quad(corner, u, v, h, false, out);
+        cut_quad(corner, u, v, h, inner, out);
     }
 }
 
@@ -273,8 +283,12 @@ fn cut_triangle(a: Vec3, b: Vec3, c: Vec3, h: f32, out: &mut Vec<Patch>) {
 
 /// Latitude–longitude patches; each has the exact area of its zone piece,
 /// r²·Δφ·(cos θ0 − cos θ1), and a parallelogram shape tangent at its centre
-/// with that area.
-fn cut_sphere(center: Vec3, r: f32, h: f32, out: &mut Vec<Patch>) {
+/// with that area. With `inner`, each piece also gives an inward patch,
+/// whose shape is moved inward by 1.5 sagittas (ρ²/2r for a shape of
+/// half-diagonal ρ): a tangent parallelogram bulges out of the sphere, so
+/// the points near its corners lie behind the inner side, where rays
+/// between neighbouring inner patches would be stopped by the sphere.
+fn cut_sphere(center: Vec3, r: f32, h: f32, inner: bool, out: &mut Vec<Patch>) {
     let bands = cells(PI * r, h).max(2);
     for i in 0..bands {
         let (t0, t1) = (PI * i as f32 / bands as f32, PI * (i + 1) as f32 / bands as f32);
@@ -297,7 +311,7 @@ fn cut_sphere(center: Vec3, r: f32, h: f32, out: &mut Vec<Patch>) {
                 e2: along_theta * height,
                 triangle: false,
             };
-            out.push(Patch {
+            let patch = Patch {
                 center: c,
                 normal: n,
                 area,
@@ -305,17 +319,39 @@ fn cut_sphere(center: Vec3, r: f32, h: f32, out: &mut Vec<Patch>) {
                 material: 0,
                 object: 0,
                 shape,
-            });
+            };
+            out.push(patch);
+            if inner {
+                let sagitta = patch.radius * patch.radius / (2.0 * r);
+                let shape = PatchShape { origin: shape.origin - n * (1.5 * sagitta), ..shape };
+                out.push(Patch { normal: -n, shape, ..patch });
+            }
         }
     }
 }
 
-/// What may lie in front of a patch: an object's bounding box, or an
-/// infinite plane.
+/// What may lie in front of a patch: an object's convex hull or a convex
+/// solid around it, given by its support function, or an infinite plane.
+/// A box or sphere (or an affine image of one) is its own hull, so that
+/// its outer side, with nothing else in front of it, sees nothing of it.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Extent {
-    Bounds(Vec3, Vec3),
-    Plane { point: Vec3, normal: Vec3 },
+    /// The parallelepiped center + M u, u in [−1, 1]³ (M's columns: the
+    /// half edges): a box, a transformed box, or the bounding box of
+    /// anything else.
+    Box {
+        center: Vec3,
+        half_edges: Mat3,
+    },
+    /// The ellipsoid center + M u, |u| ≤ 1: a sphere, a transformed sphere.
+    Ellipsoid {
+        center: Vec3,
+        axes: Mat3,
+    },
+    Plane {
+        point: Vec3,
+        normal: Vec3,
+    },
 }
 
 impl Extent {
@@ -323,49 +359,61 @@ impl Extent {
     pub fn of(shape: &Shape) -> Extent {
         match shape {
             Shape::Sdf(sdf) => match sdf.bounds() {
-                Some((lo, hi)) => Extent::Bounds(lo, hi),
-                None => Extent::Bounds(Vec3::ZERO, Vec3::ZERO),
+                Some((lo, hi)) => Extent::bounds(lo, hi),
+                None => Extent::bounds(Vec3::ZERO, Vec3::ZERO),
             },
             Shape::Plane { point, normal } => Extent::Plane { point: *point, normal: *normal },
-            Shape::Sphere { center, radius } => Extent::Bounds(center - *radius, center + *radius),
+            Shape::Sphere { center, radius } => {
+                Extent::Ellipsoid { center: *center, axes: Mat3::from_diagonal(Vec3::splat(*radius)) }
+            }
             Shape::Quad { corner, edge_u, edge_v } => {
                 Extent::points(&[*corner, corner + edge_u, corner + edge_v, corner + edge_u + edge_v])
             }
-            Shape::Box { min, max } => Extent::Bounds(*min, *max),
+            Shape::Box { min, max } => Extent::bounds(*min, *max),
             Shape::Mesh { positions, .. } => Extent::points(positions),
-            Shape::Transformed { shape, world_from_local } => match Extent::of(shape) {
-                Extent::Bounds(lo, hi) => {
-                    let corners: Vec<Vec3> = (0..8)
-                        .map(|i| {
-                            world_from_local.transform_point3(Vec3::new(
-                                if i & 1 == 0 { lo.x } else { hi.x },
-                                if i & 2 == 0 { lo.y } else { hi.y },
-                                if i & 4 == 0 { lo.z } else { hi.z },
-                            ))
-                        })
-                        .collect();
-                    Extent::points(&corners)
+            Shape::Transformed { shape, world_from_local } => {
+                let linear = Mat3::from(world_from_local.matrix3);
+                match Extent::of(shape) {
+                    Extent::Box { center, half_edges } => Extent::Box {
+                        center: world_from_local.transform_point3(center),
+                        half_edges: linear * half_edges,
+                    },
+                    Extent::Ellipsoid { center, axes } => {
+                        Extent::Ellipsoid { center: world_from_local.transform_point3(center), axes: linear * axes }
+                    }
+                    // Shape::transformed bakes planes; an instanced one is
+                    // mapped here all the same.
+                    Extent::Plane { point, normal } => Extent::Plane {
+                        point: world_from_local.transform_point3(point),
+                        normal: (linear.inverse().transpose() * normal).normalize(),
+                    },
                 }
-                plane => plane,
-            },
+            }
         }
+    }
+
+    fn bounds(lo: Vec3, hi: Vec3) -> Extent {
+        Extent::Box { center: 0.5 * (lo + hi), half_edges: Mat3::from_diagonal(0.5 * (hi - lo)) }
     }
 
     fn points(points: &[Vec3]) -> Extent {
         let lo = points.iter().copied().fold(Vec3::MAX, Vec3::min);
         let hi = points.iter().copied().fold(Vec3::MIN, Vec3::max);
-        Extent::Bounds(lo, hi)
+        Extent::bounds(lo, hi)
     }
 
     /// Whether some of it lies strictly in front of the plane through `p`
-    /// with unit normal `n` (beyond a tolerance `eps`).
+    /// with unit normal `n` (beyond a tolerance `eps`): its support
+    /// function h(n) = max over its points x of n·x exceeds n·p. For the
+    /// parallelepiped h(n) = n·c + Σ_i |n·m_i|, for the ellipsoid
+    /// h(n) = n·c + |Mᵀ n|.
     pub fn in_front(&self, p: Vec3, n: Vec3, eps: f32) -> bool {
         match *self {
-            Extent::Bounds(lo, hi) => {
-                // The box corner farthest along n.
-                let far = Vec3::select(n.cmpge(Vec3::ZERO), hi, lo);
-                n.dot(far - p) > eps
+            Extent::Box { center, half_edges: m } => {
+                let reach = n.dot(m.x_axis).abs() + n.dot(m.y_axis).abs() + n.dot(m.z_axis).abs();
+                n.dot(center - p) + reach > eps
             }
+            Extent::Ellipsoid { center, axes } => n.dot(center - p) + (axes.transpose() * n).length() > eps,
             Extent::Plane { point, normal } => {
                 let parallel = n.cross(normal).length_squared() < 1e-12;
                 !parallel || n.dot(point - p) > eps
@@ -376,9 +424,9 @@ impl Extent {
 
 /// Whether any object's extent lies in front of patch `p`. A side with
 /// nothing in front of it sees nothing and is seen by nothing, so it
-/// exchanges no light (the outside of a closed room, the underside of a
-/// floor): such sides are dropped before linking. Conservative: a side is
-/// kept whenever a bounding box reaches in front of it.
+/// exchanges no light (the outside of a closed room or dome, the underside
+/// of a floor): such sides are dropped before linking. Conservative: a side
+/// is kept whenever an extent reaches in front of it.
 pub fn faces_anything(p: &Patch, extents: &[Extent]) -> bool {
     let eps = 1e-5 * (1.0 + p.center.abs().max_element());
     extents.iter().any(|e| e.in_front(p.center, p.normal, eps))

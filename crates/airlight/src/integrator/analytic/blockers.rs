@@ -3,14 +3,26 @@
 //! whether it blocks the segment from a point to the light, and a bounding
 //! sphere to skip it for rays whose shadow segments cannot touch it.
 //!
-//! The shadow set of a convex occluder B lit from a point L outside it,
-//! {x : the segment [x, L] meets B}, is convex (the union of the segments
-//! from the points of B away from L), and an affine map keeps this true. So
-//! a ray's shadowed part, for one occluder, is one interval; its ends are
-//! among the candidates of [`super::boundaries`], and one test per piece
-//! between candidates ([`Blocker::blocks`], a segment–shape test with no
-//! acceleration structure) finds it. The union over occluders is the ray's
-//! shadow, with no shadow rays at all.
+//! Every occluder here is a surface: a ray of light is stopped where it
+//! crosses a sphere, a box's faces, a quad or a plane, as the other
+//! integrators' shadow rays are. For a closed convex surface ∂B (sphere,
+//! box, and their affine images) lit from a point L:
+//!
+//! - L outside B: a segment from L that meets B crosses ∂B, so the shadow
+//!   set {x : [x, L] meets ∂B} is {x : [x, L] meets B}, which is convex (the
+//!   union of the segments from the points of B away from L); an affine map
+//!   keeps this true. A ray's shadowed part is one interval.
+//! - L inside B (a room, a dome): [x, L] stays inside B exactly when x does
+//!   (B is convex) and crosses ∂B otherwise, so the shadow set is the
+//!   complement of B's interior: along a ray, everything but its chord
+//!   through B. Its ends are the ray's crossings of ∂B.
+//!
+//! Either way the ends of the shadowed parts are among the candidates of
+//! [`super::boundaries`], and one segment–surface test per piece between
+//! candidates ([`Blocker::blocks`], with no acceleration structure) finds
+//! them. Quads and planes are open surfaces: a segment is stopped when it
+//! crosses them, from either side. The union over occluders is the ray's
+//! shadow, with no shadow rays at all; triangles are in triangles.rs.
 
 use super::boundaries::{box_boundaries, plane_boundaries, polygon_boundaries, sphere_boundaries};
 use crate::geometry::{Geometry, Occluder};
@@ -37,11 +49,9 @@ pub(super) struct Blocker {
     pub emitter: Option<u32>,
 }
 
-/// The occluders of `geometry` other than triangles (meshes are bracketed by
-/// marching, see shadows.rs), and whether there were triangles.
-pub(super) fn blockers(geometry: &Geometry) -> (Vec<Blocker>, bool) {
+/// The occluders of `geometry` other than triangles (see triangles.rs).
+pub(super) fn blockers(geometry: &Geometry) -> Vec<Blocker> {
     let mut out = Vec::new();
-    let mut triangles = false;
     for (occluder, emitter) in geometry.occluders() {
         let (shape, center, radius) = match occluder {
             Occluder::Sphere { center, radius } => {
@@ -72,14 +82,11 @@ pub(super) fn blockers(geometry: &Geometry) -> (Vec<Blocker>, bool) {
                 let (wc, wr) = world_sphere(&m, 0.5 * (a + b), 0.5 * (b - a).length());
                 (Shape::InstancedBox { local_from_world: m, min: a, max: b }, wc, wr)
             }
-            Occluder::Triangle { .. } => {
-                triangles = true;
-                continue;
-            }
+            Occluder::Triangle { .. } => continue,
         };
         out.push(Blocker { shape, center, radius, emitter });
     }
-    (out, triangles)
+    out
 }
 
 /// A world sphere holding the local sphere (c, r): the centre mapped back,
@@ -165,37 +172,49 @@ impl Blocker {
         }
     }
 
-    /// Whether the segment x + s (y − x), s in (0, 1), meets the occluder.
+    /// Whether the segment x + s (y − x), s in (0, 1), crosses the
+    /// occluder's surface.
     pub fn blocks(&self, x: DVec3, y: DVec3) -> bool {
         match self.shape {
-            Shape::Sphere { center, radius } => segment_meets_ball(x, y, center, radius),
-            Shape::Box { min, max } => segment_meets_box(x, y, min, max),
+            Shape::Sphere { center, radius } => segment_crosses_sphere(x, y, center, radius),
+            Shape::Box { min, max } => segment_crosses_box(x, y, min, max),
             Shape::Quad { corner, edge_u, edge_v } => segment_meets_quad(x, y, corner, edge_u, edge_v),
             Shape::Plane { point, normal } => {
                 let (a, b) = (normal.dot(x - point), normal.dot(y - point));
                 (a > 0.0 && b < 0.0) || (a < 0.0 && b > 0.0)
             }
             Shape::InstancedSphere { local_from_world: m, center, radius } => {
-                segment_meets_ball(m.transform_point3(x), m.transform_point3(y), center, radius)
+                segment_crosses_sphere(m.transform_point3(x), m.transform_point3(y), center, radius)
             }
             Shape::InstancedBox { local_from_world: m, min, max } => {
-                segment_meets_box(m.transform_point3(x), m.transform_point3(y), min, max)
+                segment_crosses_box(m.transform_point3(x), m.transform_point3(y), min, max)
             }
         }
     }
 }
 
-/// Whether the open segment (x, y) meets the closed ball: the point of the
-/// segment's line nearest the centre, clamped to the segment, lies within R.
-fn segment_meets_ball(x: DVec3, y: DVec3, center: DVec3, radius: f64) -> bool {
+/// Whether the segment (x, y) crosses the sphere: it meets the closed ball
+/// (the point of the segment's line nearest the centre, clamped to the
+/// segment, lies within R) and does not lie inside it (a segment with both
+/// ends inside a convex solid stays inside).
+fn segment_crosses_sphere(x: DVec3, y: DVec3, center: DVec3, radius: f64) -> bool {
+    let r2 = radius * radius;
+    let inside = |p: DVec3| (p - center).length_squared() < r2;
+    if inside(x) && inside(y) {
+        return false;
+    }
     let v = y - x;
     let s = (v.dot(center - x) / v.length_squared()).clamp(0.0, 1.0);
-    (x + v * s - center).length_squared() <= radius * radius
+    (x + v * s - center).length_squared() <= r2
 }
 
-/// Whether the segment (x, y) meets the box: slabs (Kay and Kajiya 1986) on
-/// s in [0, 1].
-fn segment_meets_box(x: DVec3, y: DVec3, min: DVec3, max: DVec3) -> bool {
+/// Whether the segment (x, y) crosses the box's faces: it meets the box
+/// (slabs, Kay and Kajiya 1986, on s in [0, 1]) and does not lie inside it.
+fn segment_crosses_box(x: DVec3, y: DVec3, min: DVec3, max: DVec3) -> bool {
+    let inside = |p: DVec3| p.cmpgt(min).all() && p.cmplt(max).all();
+    if inside(x) && inside(y) {
+        return false;
+    }
     let v = y - x;
     let inv = v.recip();
     let (ta, tb) = ((min - x) * inv, (max - x) * inv);

@@ -45,22 +45,29 @@
 //! isotropic scattering when the extinction along the different paths from
 //! its surface is neglected, O(σt R)).
 //!
-//! Shadows (`shadows = true`): without meshes, each occluder's shadow along
-//! the ray is one interval, found exactly from its boundaries and cheap
-//! segment–shape tests, with no shadow rays (blockers.rs, shadows.rs);
-//! occluders whose bounding sphere cannot touch the triangle swept by the
-//! ray's shadow segments are skipped. With meshes, boundaries are bracketed
-//! by a coarse march and bisection and each piece takes one shadow ray.
+//! Shadows (`shadows = true`): each occluder's shadow along the ray is
+//! found exactly, with no shadow rays, for any arrangement of lights,
+//! camera and occluders (a light or the camera inside a box, a sphere or a
+//! closed mesh, between planes): spheres, boxes, quads and planes from
+//! their boundaries and one segment–surface test per piece (blockers.rs),
+//! triangles by clipping the ray against each one's shadow volume, found
+//! through a bounding volume hierarchy (triangles.rs); occluders whose
+//! bounds cannot touch the triangle swept by the ray's shadow segments are
+//! skipped (shadows.rs).
 //!
 //! What it refuses, with a message naming the light or object and the
 //! integrator to use instead ([`Analytic::new`]): height fog (the closed form
 //! needs a homogeneous medium), volume lights, distant lights in a medium,
 //! lights with a real-time attenuation model other than `physical` (the
-//! closed form integrates 1/r²), and SDF objects when `shadows` is on (they
-//! have no exact shadow boundaries; without shadows they only end rays).
+//! closed form integrates 1/r²), and when `shadows` is on SDF objects (they
+//! have no exact shadow boundaries; without shadows they only end rays) and
+//! sphere lights that a surface cuts through (shadowed as a point at their
+//! centre, they would light nothing on the far side of a surface that their
+//! ball reaches through; see clearance.rs).
 
 mod blockers;
 mod boundaries;
+mod clearance;
 mod closed_form;
 mod expint;
 mod lights;
@@ -68,6 +75,7 @@ mod modulation;
 mod quadrature;
 mod shadows;
 mod table;
+mod triangles;
 
 pub use boundaries::{
     box_boundaries, box_edges, cone_crossings, edge_boundaries, plane_boundaries, polygon_boundaries, quadratic_roots,
@@ -82,7 +90,8 @@ pub use table::{TABLE_ERROR, im_s as im_s_tabulated, sun_f_tabulated};
 use blockers::Blocker;
 use lights::Extended;
 use modulation::MediumConsts;
-use shadows::{in_intervals, visible};
+use shadows::in_intervals;
+use triangles::MeshShadows;
 
 use super::{Integrator, IntegratorError, IntegratorKind, no_extra, single_scattering};
 use crate::Rgb;
@@ -170,21 +179,19 @@ pub struct Analytic {
     rule: Rule,
     /// The occluders other than triangles, in f64 (for shadows).
     blockers: Vec<Blocker>,
-    /// Whether some occluder is a triangle: shadow boundaries on meshes are
-    /// bracketed by a coarse march and refined by bisection.
-    meshes: bool,
+    /// The meshes' triangles (for shadows).
+    meshes: MeshShadows,
 }
 
-/// Coarse march samples per ray for shadow boundaries on meshes.
-pub const MESH_MARCH_STEPS: usize = 64;
 /// Gauss–Legendre points per panel for a non-constant phase or emission.
 const MODULATED_POINTS: usize = 16;
 
 impl Analytic {
     /// The integrator for `scene`, or why it cannot render it (a message for
     /// the user, never a panic): height fog, volume lights, distant lights
-    /// in a medium, non-physical attenuation models, and SDF objects with
-    /// shadows are refused (see the module documentation).
+    /// in a medium, non-physical attenuation models, and with shadows SDF
+    /// objects and sphere lights cut by a surface are refused (see the
+    /// module documentation).
     pub fn new(scene: &Scene, options: AnalyticOptions) -> Result<Analytic, String> {
         let in_medium = scene.medium().is_some_and(|m| m.sigma_s != Rgb::ZERO);
         if options.shadows && scene.geometry().has_sdf() {
@@ -297,12 +304,18 @@ impl Analytic {
         }
         emitters.retain(|e| e.intensity != DVec3::ZERO);
         extended.retain(|e| e.intensity() != DVec3::ZERO);
-        let (blockers, meshes) = blockers::blockers(scene.geometry());
+        let blockers = blockers::blockers(scene.geometry());
+        let meshes = if options.shadows { MeshShadows::of_scene(scene) } else { MeshShadows::default() };
+        if options.shadows {
+            clearance::check_sphere_lights(scene.lights(), &blockers, &meshes)?;
+        }
         Ok(Analytic { options, emitters, extended, rule, blockers, meshes })
     }
 
     /// Single-scattered radiance along `ray` over [0, t_end] from all lights.
-    pub fn in_scattered(&self, scene: &Scene, medium: &Medium, ray: &Ray, t_end: f32) -> Rgb {
+    /// The scene's occluders were prepared by [`Analytic::new`]; `_scene` is
+    /// kept for the callers' sake (the other integrators' signature).
+    pub fn in_scattered(&self, _scene: &Scene, medium: &Medium, ray: &Ray, t_end: f32) -> Rgb {
         if medium.sigma_s == Rgb::ZERO || t_end.is_nan() || t_end <= 0.0 {
             return Rgb::ZERO;
         }
@@ -317,11 +330,11 @@ impl Analytic {
         let run = |scratch: &mut Scratch| {
             let mut total = DVec3::ZERO;
             for e in &self.emitters {
-                total += self.emitter_light(scene, &consts, o, d, t_end, e, scratch);
+                total += self.emitter_light(&consts, o, d, t_end, e, scratch);
             }
             for x in &self.extended {
                 let mut each = |e: &PointEmitter| {
-                    total += self.emitter_light(scene, &consts, o, d, t_end, e, scratch);
+                    total += self.emitter_light(&consts, o, d, t_end, e, scratch);
                 };
                 match *x {
                     Extended::Line { start, end, intensity, light } => {
@@ -345,7 +358,6 @@ impl Analytic {
     #[allow(clippy::too_many_arguments)]
     fn emitter_light(
         &self,
-        scene: &Scene,
         k: &MediumConsts,
         o: DVec3,
         d: DVec3,
@@ -373,8 +385,7 @@ impl Analytic {
                 plane_boundaries(p, normal, o, d, range, &mut s.cuts);
             }
         }
-        let exact_shadows = self.options.shadows && !self.meshes;
-        if exact_shadows {
+        if self.options.shadows {
             self.shadow_intervals(e, o, d, range, &mut s.cands, &mut s.shadow);
             if s.shadow.first().is_some_and(|&(a, b)| a <= 0.0 && b >= t_end) {
                 return DVec3::ZERO;
@@ -382,8 +393,6 @@ impl Analytic {
             for &(a, b) in &s.shadow {
                 s.cuts.extend([a, b].into_iter().filter(|&t| t > 0.0 && t < t_end));
             }
-        } else if self.options.shadows {
-            self.shadow_boundaries(scene, e, o, d, range, &mut s.cuts);
         }
         s.cuts.sort_unstable_by(f64::total_cmp);
         s.cuts.dedup_by(|a, b| *a - *b <= 1e-12 * t_end);
@@ -400,9 +409,7 @@ impl Analytic {
             let Some(constant) = self.modulation_class(k, x, e) else {
                 continue;
             };
-            if exact_shadows && in_intervals(&s.shadow, tm)
-                || self.options.shadows && self.meshes && !visible(scene, x, e)
-            {
+            if self.options.shadows && in_intervals(&s.shadow, tm) {
                 continue;
             }
             let mut piece = [0.0; 3];
