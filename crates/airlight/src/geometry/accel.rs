@@ -160,48 +160,6 @@ pub fn shadow_rays_traced() -> u64 {
     SHADOW_RAYS.with(|n| n.get())
 }
 
-/// A primitive as code that needs the shapes themselves sees it (the
-/// analytic integrator's exact shadow boundaries), with the light it is the
-/// surface of, if any.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum Occluder {
-    Sphere {
-        center: Vec3,
-        radius: f32,
-    },
-    Quad {
-        corner: Vec3,
-        edge_u: Vec3,
-        edge_v: Vec3,
-    },
-    Box {
-        min: Vec3,
-        max: Vec3,
-    },
-    Triangle {
-        v0: Vec3,
-        e1: Vec3,
-        e2: Vec3,
-    },
-    /// A sphere in its own space; `local_from_world` maps world points to it.
-    InstancedSphere {
-        local_from_world: Affine3A,
-        center: Vec3,
-        radius: f32,
-    },
-    /// A box in its own space.
-    InstancedBox {
-        local_from_world: Affine3A,
-        min: Vec3,
-        max: Vec3,
-    },
-    /// An infinite plane.
-    Plane {
-        point: Vec3,
-        normal: Vec3,
-    },
-}
-
 /// What a ray hit: its distance and which primitive.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Hit {
@@ -410,37 +368,6 @@ impl Geometry {
     /// Whether any primitive is a signed distance field.
     pub fn has_sdf(&self) -> bool {
         self.records.iter().any(|rec| matches!(rec.prim, Prim::Sdf(_)))
-    }
-
-    /// Every primitive and plane, with the light each is the surface of.
-    pub fn occluders(&self) -> impl Iterator<Item = (Occluder, Option<u32>)> + '_ {
-        let bounded = self.records.iter().filter_map(|rec| {
-            let occluder = match &rec.prim {
-                Prim::Sphere { center, radius } => Occluder::Sphere { center: *center, radius: *radius },
-                Prim::Quad { corner, edge_u, edge_v } => {
-                    Occluder::Quad { corner: *corner, edge_u: *edge_u, edge_v: *edge_v }
-                }
-                Prim::Box { min, max } => Occluder::Box { min: *min, max: *max },
-                Prim::Triangle { v0, e1, e2 } => Occluder::Triangle { v0: *v0, e1: *e1, e2: *e2 },
-                Prim::Instance(inst) => match inst.prim {
-                    Prim::Box { min, max } => {
-                        Occluder::InstancedBox { local_from_world: inst.local_from_world, min, max }
-                    }
-                    Prim::Sphere { center, radius } => {
-                        Occluder::InstancedSphere { local_from_world: inst.local_from_world, center, radius }
-                    }
-                    // GeometryBuilder::add instances only spheres and boxes.
-                    _ => return None,
-                },
-                // No exact shadow boundary: the analytic integrator refuses
-                // shadows in scenes with SDF objects (see has_sdf).
-                Prim::Sdf(_) => return None,
-            };
-            Some((occluder, rec.emitter))
-        });
-        let planes =
-            self.planes.iter().map(|plane| (Occluder::Plane { point: plane.point, normal: plane.normal }, None));
-        bounded.chain(planes)
     }
 
     /// The nearest hit found by testing every primitive: the oracle that the

@@ -25,7 +25,8 @@
 //! shadow, with no shadow rays at all; triangles are in triangles.rs.
 
 use super::boundaries::{box_boundaries, plane_boundaries, polygon_boundaries, sphere_boundaries};
-use crate::geometry::{Geometry, Occluder};
+use crate::geometry::Shape as SceneShape;
+use crate::scene::Scene;
 use glam::{DAffine3, DMat3, DVec3};
 
 /// An occluder in f64; instanced shapes keep their world-to-local map.
@@ -49,44 +50,58 @@ pub(super) struct Blocker {
     pub emitter: Option<u32>,
 }
 
-/// The occluders of `geometry` other than triangles (see triangles.rs).
-pub(super) fn blockers(geometry: &Geometry) -> Vec<Blocker> {
+/// The scene's surfaces as occluders, in f64: its objects and its area
+/// lights' surfaces, made from the scene's own shapes. Triangles are in
+/// triangles.rs; SDF objects have no exact shadow boundary (the integrator
+/// refuses shadows with them).
+pub(super) fn blockers(scene: &Scene) -> Vec<Blocker> {
     let mut out = Vec::new();
-    for (occluder, emitter) in geometry.occluders() {
-        let (shape, center, radius) = match occluder {
-            Occluder::Sphere { center, radius } => {
-                let (c, r) = (center.as_dvec3(), radius as f64);
-                (Shape::Sphere { center: c, radius: r }, c, r)
-            }
-            Occluder::Box { min, max } => {
-                let (a, b) = (min.as_dvec3(), max.as_dvec3());
-                (Shape::Box { min: a, max: b }, 0.5 * (a + b), 0.5 * (b - a).length())
-            }
-            Occluder::Quad { corner, edge_u, edge_v } => {
+    for surface in scene.surfaces() {
+        let emitter = surface.emitter;
+        let (shape, center, radius) = match surface.shape {
+            SceneShape::Sphere { center, radius } => sphere(center, radius),
+            SceneShape::Box { min, max } => cuboid(min, max),
+            SceneShape::Quad { corner, edge_u, edge_v } => {
                 let (c, u, v) = (corner.as_dvec3(), edge_u.as_dvec3(), edge_v.as_dvec3());
                 let r = 0.5 * (u + v).length().max((u - v).length());
                 (Shape::Quad { corner: c, edge_u: u, edge_v: v }, c + 0.5 * (u + v), r)
             }
-            Occluder::Plane { point, normal } => {
+            SceneShape::Plane { point, normal } => {
                 (Shape::Plane { point: point.as_dvec3(), normal: normal.as_dvec3() }, DVec3::ZERO, f64::INFINITY)
             }
-            Occluder::InstancedSphere { local_from_world, center, radius } => {
-                let m = to_f64(&local_from_world);
-                let (c, r) = (center.as_dvec3(), radius as f64);
-                let (wc, wr) = world_sphere(&m, c, r);
-                (Shape::InstancedSphere { local_from_world: m, center: c, radius: r }, wc, wr)
+            // `Shape::transformed` keeps only spheres and boxes under a
+            // transform; the rest it bakes into world space.
+            SceneShape::Transformed { shape, world_from_local } => {
+                let m = to_f64(&world_from_local.inverse());
+                match *shape {
+                    SceneShape::Sphere { center, radius } => {
+                        let (c, r) = (center.as_dvec3(), radius as f64);
+                        let (wc, wr) = world_sphere(&m, c, r);
+                        (Shape::InstancedSphere { local_from_world: m, center: c, radius: r }, wc, wr)
+                    }
+                    SceneShape::Box { min, max } => {
+                        let (a, b) = (min.as_dvec3(), max.as_dvec3());
+                        let (wc, wr) = world_sphere(&m, 0.5 * (a + b), 0.5 * (b - a).length());
+                        (Shape::InstancedBox { local_from_world: m, min: a, max: b }, wc, wr)
+                    }
+                    _ => continue,
+                }
             }
-            Occluder::InstancedBox { local_from_world, min, max } => {
-                let m = to_f64(&local_from_world);
-                let (a, b) = (min.as_dvec3(), max.as_dvec3());
-                let (wc, wr) = world_sphere(&m, 0.5 * (a + b), 0.5 * (b - a).length());
-                (Shape::InstancedBox { local_from_world: m, min: a, max: b }, wc, wr)
-            }
-            Occluder::Triangle { .. } => continue,
+            SceneShape::Mesh { .. } | SceneShape::Sdf(_) => continue,
         };
         out.push(Blocker { shape, center, radius, emitter });
     }
     out
+}
+
+fn sphere(center: glam::Vec3, radius: f32) -> (Shape, DVec3, f64) {
+    let (c, r) = (center.as_dvec3(), radius as f64);
+    (Shape::Sphere { center: c, radius: r }, c, r)
+}
+
+fn cuboid(min: glam::Vec3, max: glam::Vec3) -> (Shape, DVec3, f64) {
+    let (a, b) = (min.as_dvec3(), max.as_dvec3());
+    (Shape::Box { min: a, max: b }, 0.5 * (a + b), 0.5 * (b - a).length())
 }
 
 /// A world sphere holding the local sphere (c, r): the centre mapped back,

@@ -304,7 +304,7 @@ impl Analytic {
         }
         emitters.retain(|e| e.intensity != DVec3::ZERO);
         extended.retain(|e| e.intensity() != DVec3::ZERO);
-        let blockers = blockers::blockers(scene.geometry());
+        let blockers = blockers::blockers(scene);
         let meshes = if options.shadows { MeshShadows::of_scene(scene) } else { MeshShadows::default() };
         if options.shadows {
             clearance::check_sphere_lights(scene.lights(), &blockers, &meshes)?;
