@@ -8,7 +8,9 @@ use clap::{Parser, Subcommand};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
+mod merge;
 mod plot;
+mod progress;
 mod render;
 mod view;
 
@@ -39,6 +41,8 @@ enum Command {
     /// Fly through a scene and move its lights in a window (with none: the
     /// built-in Cornell box), or replay a scripted path with --headless.
     View(view::ViewArgs),
+    /// Add up partial renders (`render --shard/--tile`) into the image.
+    Merge(merge::MergeArgs),
     /// Compare two EXR images: prints rmse, rel_mse, mae and max.
     Compare {
         image: PathBuf,
@@ -104,6 +108,7 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Render(args) => render::render(args),
+        Command::Merge(args) => merge::merge(args),
         Command::Info { scene } => info(&scene),
         Command::Compare { image, reference, map } => compare(&image, &reference, map.as_deref()),
         Command::Attenuation(args) => attenuation(args),

@@ -1,14 +1,18 @@
 //! `airlight render`: one image, progressive passes (optionally until an
-//! error target), or the numbered frames of a light animation.
+//! error target), the numbered frames of a light animation, or a part of a
+//! render (a range of samples, a band of rows, one frame) for a render farm
+//! to merge.
 
 use crate::load;
+use crate::progress::Progress;
 use airlight::SceneFile;
 use airlight::film::Image;
+use airlight::film::partial::{Partial, PartialHeader, piece};
 use airlight::integrator::analytic::LightQuadrature;
 use airlight::integrator::{Integrator, IntegratorKind, Sampling};
-use airlight::render::{Progressive, RenderObserver, frame_time, set_time};
+use airlight::render::{Progressive, RenderObserver, accumulate, frame_time, set_time};
 use airlight::scene::Scene;
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use std::ops::Range;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -50,6 +54,17 @@ pub struct RenderArgs {
     /// NAME_0000.png, NAME_0001.png, ...
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..))]
     frames: Option<u32>,
+    /// With --frames N: only frame K (0 ≤ K < N), named as --frames names it.
+    #[arg(long, value_name = "K", requires = "frames")]
+    frame: Option<u32>,
+    /// Only the K-th of N contiguous ranges of each pixel's samples
+    /// (0 ≤ K < N), written as a partial EXR for `airlight merge`.
+    #[arg(long, value_name = "K/N", value_parser = parse_part)]
+    shard: Option<(u32, u32)>,
+    /// Only the K-th of N bands of rows (0 ≤ K < N), written as a partial
+    /// EXR for `airlight merge`; combines with --shard.
+    #[arg(long, value_name = "K/N", value_parser = parse_part)]
+    tile: Option<(u32, u32)>,
     /// Samples per pixel.
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
     spp: Option<u32>,
@@ -89,8 +104,67 @@ struct FrameOutputs {
     variance: Option<PathBuf>,
 }
 
+/// What one `render` command computes: which frames, which samples of
+/// which rows, and whether as a partial render.
+struct Plan {
+    /// Frame numbers to render, with the count; None for a still image.
+    frames: Option<(Vec<u32>, u32)>,
+    samples: Range<u64>,
+    rows: Range<u32>,
+    /// A shard or tile: written as a partial EXR.
+    partial: bool,
+}
+
+impl Plan {
+    fn new(args: &RenderArgs, scene: &Scene) -> Result<Plan, String> {
+        let s = scene.settings();
+        let frames = match (args.frames, args.frame) {
+            (Some(n), Some(k)) if k >= n => {
+                return Err(format!("--frame {k}: the animation has frames 0 to {} (--frames {n})", n - 1));
+            }
+            (Some(n), Some(k)) => Some((vec![k], n)),
+            (Some(n), None) => Some(((0..n).collect(), n)),
+            (None, _) => None,
+        };
+        let part = |what: &str, part: Option<(u32, u32)>, total: u64, unit: &str| -> Result<Range<u64>, String> {
+            match part {
+                None => Ok(0..total),
+                Some((_, n)) if n as u64 > total => {
+                    Err(format!("--{what} K/{n}: the render has only {total} {unit}, so at most {total} {what}s"))
+                }
+                Some((k, n)) => Ok(piece(total, k as u64, n as u64)),
+            }
+        };
+        let samples = part("shard", args.shard, s.spp as u64, "samples per pixel")?;
+        let rows = part("tile", args.tile, s.height as u64, "rows")?;
+        let partial = args.shard.is_some() || args.tile.is_some();
+        if partial {
+            if args.progressive || args.target_error.is_some() || args.variance.is_some() {
+                return Err("--shard and --tile render a fixed part of the samples: they do not go with \
+                            --progressive, --target-error or --variance (merge the parts, then compare)"
+                    .into());
+            }
+            match args.output.as_slice() {
+                [one] if one.extension().is_some_and(|e| e.eq_ignore_ascii_case("exr")) => {}
+                _ => return Err("--shard and --tile write one partial render: give one `-o PART.exr`".into()),
+            }
+        }
+        Ok(Plan { frames, samples, rows: rows.start as u32..rows.end as u32, partial })
+    }
+
+    /// Pixel samples this plan renders.
+    fn work(&self, scene: &Scene) -> u64 {
+        let frames = self.frames.as_ref().map_or(1, |(list, _)| list.len() as u64);
+        let pixels = scene.settings().width as u64 * (self.rows.end - self.rows.start) as u64;
+        frames * pixels * (self.samples.end - self.samples.start)
+    }
+}
+
 pub fn render(args: RenderArgs) -> Result<(), String> {
     let SceneFile { mut scene, integrator: desc } = configure(&args)?;
+    // Of the scene as resolved, before any frame moves its lights.
+    let fingerprint = airlight::fingerprint(&scene, &desc);
+    let plan = Plan::new(&args, &scene)?;
     let outputs = output_paths(&args)?;
     if let Some(v) = &args.variance
         && !v.extension().is_some_and(|e| e.eq_ignore_ascii_case("exr"))
@@ -108,55 +182,67 @@ pub fn render(args: RenderArgs) -> Result<(), String> {
         .build()
         .map_err(|e| format!("cannot start worker threads: {e}"))?;
     let progressive = args.progressive || args.target_error.is_some() || args.variance.is_some();
-    let frames = args.frames.unwrap_or(1);
-    let s = scene.settings();
-    let per_frame = s.width as u64 * s.height as u64 * s.spp as u64;
-    let bar = if args.quiet {
-        ProgressBar::hidden()
-    } else {
-        ProgressBar::with_draw_target(Some(per_frame * frames as u64), ProgressDrawTarget::stderr())
-    };
-    if let Ok(style) = ProgressStyle::with_template("{spinner} {msg} [{bar:40}] {percent}% {elapsed} (eta {eta})") {
-        bar.set_style(style.progress_chars("=> "));
-    }
+    let progress = Progress::new(plan.work(&scene), args.quiet);
     let start = Instant::now();
     // Built once: between frames the integrator only hears that the lights
     // moved (radiosity relights without recompiling).
     let mut integrator = pool.install(|| desc.build(&scene)).map_err(|e| e.to_string())?;
     let mut written = Vec::new();
-    for frame in 0..frames {
-        let outputs = match args.frames {
-            Some(_) => {
-                pool.install(|| set_time(&mut scene, integrator.as_mut(), frame_time(frame, frames)))
+    let frames: Vec<Option<(u32, u32)>> = match &plan.frames {
+        Some((list, n)) => list.iter().map(|&k| Some((k, *n))).collect(),
+        None => vec![None],
+    };
+    for frame in frames {
+        let outputs = match frame {
+            Some((k, n)) => {
+                pool.install(|| set_time(&mut scene, integrator.as_mut(), frame_time(k, n)))
                     .map_err(|e| e.to_string())?;
                 FrameOutputs {
-                    images: outputs.iter().map(|p| numbered(p, frame)).collect(),
-                    variance: args.variance.as_deref().map(|p| numbered(p, frame)),
+                    images: outputs.iter().map(|p| numbered(p, k)).collect(),
+                    variance: args.variance.as_deref().map(|p| numbered(p, k)),
                 }
             }
             None => FrameOutputs { images: outputs.clone(), variance: args.variance.clone() },
         };
-        let frame_label = args.frames.map(|n| format!(" frame {}/{n}", frame + 1)).unwrap_or_default();
+        let frame_label = frame.map(|(k, n)| format!(" frame {k} of {n}")).unwrap_or_default();
         let label = format!("{}{frame_label}", desc.kind);
-        let summary = if progressive {
-            render_progressive(&scene, integrator.as_ref(), &pool, &bar, &outputs, args.target_error, &label)?
+        let summary = if plan.partial {
+            let header = PartialHeader {
+                version: env!("CARGO_PKG_VERSION").into(),
+                scene: fingerprint.clone(),
+                seed: scene.settings().seed,
+                width: scene.settings().width,
+                height: scene.settings().height,
+                spp: scene.settings().spp,
+                samples: plan.samples.clone(),
+                rows: plan.rows.clone(),
+                frame,
+                exposure: scene.settings().exposure,
+                tonemap: scene.settings().tonemap,
+            };
+            render_partial(&scene, integrator.as_ref(), &pool, &progress, &outputs.images[0], header, &label)?
+        } else if progressive {
+            render_progressive(&scene, integrator.as_ref(), &pool, &progress, &outputs, args.target_error, &label)?
         } else {
-            render_once(&scene, integrator.as_ref(), &pool, &bar, &outputs, &label)?
+            render_once(&scene, integrator.as_ref(), &pool, &progress, &outputs, &label)?
         };
-        if !args.quiet && args.frames.is_none() && !summary.is_empty() {
-            bar.suspend(|| eprintln!("{summary}"));
+        if !args.quiet && plan.frames.is_none() && !summary.is_empty() {
+            progress.println(&summary);
         }
         written.extend(outputs.images.iter().map(|p| p.display().to_string()));
         written.extend(outputs.variance.iter().map(|p| p.display().to_string()));
     }
     let elapsed = start.elapsed();
-    bar.finish_and_clear();
+    progress.finish();
     if !args.quiet {
         let s = scene.settings();
-        let what = match args.frames {
-            Some(n) => format!("{n} frames of {}×{}", s.width, s.height),
-            None => format!("{}×{}", s.width, s.height),
-        };
+        let mut what = format!("{}×{}", s.width, s.height);
+        if let Some((list, n)) = &plan.frames {
+            what = format!("{} of {n} frames of {what}", list.len());
+        }
+        if plan.partial {
+            what = format!("samples {:?} of rows {:?} of {what}", plan.samples, plan.rows);
+        }
         let shown = if written.len() > 4 {
             format!("{}, …, {}", written[0], written[written.len() - 1])
         } else {
@@ -257,16 +343,35 @@ fn render_once(
     scene: &Scene,
     integrator: &dyn Integrator,
     pool: &rayon::ThreadPool,
-    bar: &ProgressBar,
+    progress: &Progress,
     outputs: &FrameOutputs,
     label: &str,
 ) -> Result<String, String> {
     let s = scene.settings();
-    bar.set_message(format!("{label} {}×{} {} spp", s.width, s.height, s.spp));
-    let progress = |n: u64| bar.inc(n);
-    let observer = RenderObserver { progress: Some(&progress), cancel: None };
+    progress.set_message(format!("{label} {}×{} {} spp", s.width, s.height, s.spp));
+    let inc = |n: u64| progress.inc(n);
+    let observer = RenderObserver { progress: Some(&inc), cancel: None };
     let image = pool.install(|| airlight::render(scene, integrator, &observer));
     write_images(scene, &image, &outputs.images)?;
+    Ok(String::new())
+}
+
+/// One part of a render (`header`'s samples of its rows), written as a
+/// partial EXR.
+fn render_partial(
+    scene: &Scene,
+    integrator: &dyn Integrator,
+    pool: &rayon::ThreadPool,
+    progress: &Progress,
+    output: &Path,
+    header: PartialHeader,
+    label: &str,
+) -> Result<String, String> {
+    progress.set_message(format!("{label} samples {:?} of rows {:?}", header.samples, header.rows));
+    let inc = |n: u64| progress.inc(n);
+    let observer = RenderObserver { progress: Some(&inc), cancel: None };
+    let sums = pool.install(|| accumulate(scene, integrator, header.samples.clone(), header.rows.clone(), &observer));
+    Partial { header, sums }.write(output).map_err(|e| format!("cannot write `{}`: {e}", output.display()))?;
     Ok(String::new())
 }
 
@@ -277,7 +382,7 @@ fn render_progressive(
     scene: &Scene,
     integrator: &dyn Integrator,
     pool: &rayon::ThreadPool,
-    bar: &ProgressBar,
+    progress: &Progress,
     outputs: &FrameOutputs,
     target_error: Option<f64>,
     label: &str,
@@ -286,11 +391,11 @@ fn render_progressive(
     let mut progressive = Progressive::new(scene);
     let mut error = f64::INFINITY;
     while !progressive.finished() && !target_error.is_some_and(|target| error < target) {
-        let progress = |n: u64| bar.inc(n);
-        let observer = RenderObserver { progress: Some(&progress), cancel: None };
+        let inc = |n: u64| progress.inc(n);
+        let observer = RenderObserver { progress: Some(&inc), cancel: None };
         pool.install(|| progressive.pass(scene, integrator, &observer));
         error = progressive.estimated_relative_error();
-        bar.set_message(format!(
+        progress.set_message(format!(
             "{label} {}×{} {}/{} spp, est. error {}",
             s.width,
             s.height,
@@ -307,9 +412,10 @@ fn render_progressive(
     }
     // Samples skipped by reaching the target still count toward the bar.
     let skipped = (s.spp - progressive.samples()) as u64 * s.width as u64 * s.height as u64;
-    bar.inc(skipped);
+    progress.inc(skipped);
     Ok(format!("{} spp, estimated relative error {}", progressive.samples(), format_error(error)))
 }
+
 fn format_error(error: f64) -> String {
     if error.is_finite() { format!("{error:.4}") } else { "unknown (fewer than 2 samples)".into() }
 }
@@ -319,6 +425,14 @@ fn parse_target_error(s: &str) -> Result<f64, String> {
         Ok(e) if e > 0.0 && e.is_finite() => Ok(e),
         _ => Err(format!("`{s}` is not a positive number (a relative error, e.g. 0.01)")),
     }
+}
+
+/// `K/N` with 0 ≤ K < N.
+fn parse_part(s: &str) -> Result<(u32, u32), String> {
+    let bad = || format!("`{s}` is not K/N with whole numbers 0 ≤ K < N (e.g. 2/8)");
+    let (k, n) = s.split_once('/').ok_or_else(bad)?;
+    let (k, n): (u32, u32) = (k.trim().parse().map_err(|_| bad())?, n.trim().parse().map_err(|_| bad())?);
+    if k < n { Ok((k, n)) } else { Err(bad()) }
 }
 
 fn parse_light_quadrature(s: &str) -> Result<LightQuadrature, String> {

@@ -49,7 +49,7 @@ pub use camera::Camera;
 pub use film::Image;
 pub use render::{RenderObserver, render};
 pub use scene::{Scene, SceneBuilder};
-pub use scene_file::SceneFile;
+pub use scene_file::{SceneFile, fingerprint};
 
 /// The names most programs need.
 pub mod prelude {

@@ -5,9 +5,11 @@
 
 mod accumulator;
 mod compare;
+pub mod partial;
 
 pub use accumulator::{ACCUMULATOR_BYTES_PER_PIXEL, Accumulator, PixelSum, SQUARE_FRACTION_BITS, SUM_FRACTION_BITS};
 pub use compare::{ImageError, compare, error_map};
+pub use partial::{Partial, PartialHeader};
 
 use crate::Rgb;
 use std::io;

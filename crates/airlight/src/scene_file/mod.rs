@@ -33,5 +33,31 @@ impl SceneFile {
     }
 }
 
+/// A fingerprint of a scene as resolved for a render (its file's values and
+/// every command-line override) and of the integrator description: 16
+/// hexadecimal digits of a 64-bit FNV-1a hash of their full debug
+/// description (every shape, light, material, setting and option). Parts
+/// of one render carry it so that `merge` refuses parts of another.
+pub fn fingerprint(scene: &Scene, integrator: &IntegratorDesc) -> String {
+    use std::fmt::Write;
+    let mut hash = Fnv1a(0xcbf2_9ce4_8422_2325);
+    // Writing into the hash cannot fail.
+    let _ = write!(hash, "{scene:?}\n{integrator:?}");
+    format!("{:016x}", hash.0)
+}
+
+/// FNV-1a, 64 bits (Fowler, Noll and Vo): a hash that is the same on every
+/// machine and Rust version, fed by `write!`.
+struct Fnv1a(u64);
+
+impl std::fmt::Write for Fnv1a {
+    fn write_str(&mut self, s: &str) -> std::fmt::Result {
+        for &b in s.as_bytes() {
+            self.0 = (self.0 ^ b as u64).wrapping_mul(0x0000_0100_0000_01b3);
+        }
+        Ok(())
+    }
+}
+
 #[cfg(test)]
 mod tests;

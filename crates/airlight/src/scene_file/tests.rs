@@ -80,3 +80,22 @@ fn fog_without_an_integrator_named_is_ray_marched() {
     assert_eq!(file.integrator.kind, IntegratorKind::Raymarch);
     assert_eq!(SceneFile::from_toml_str("", None).unwrap().integrator.kind, IntegratorKind::Direct);
 }
+
+#[test]
+fn the_fingerprint_follows_every_value_that_changes_the_image() {
+    let file = || SceneFile::from_toml_str(SCENE, None).unwrap();
+    let a = file();
+    let print = |f: &SceneFile| super::fingerprint(&f.scene, &f.integrator);
+    assert_eq!(print(&a), print(&file()), "the same scene, the same fingerprint");
+    assert_eq!(print(&a).len(), 16);
+    let mut spp = file();
+    spp.scene.settings_mut().spp = 3;
+    let mut light = file();
+    let moved: Vec<Light> = light.scene.lights().iter().map(|l| l.moved_to(vec3(0.0, 5.0, 0.001))).collect();
+    light.scene.set_lights(&moved);
+    let mut steps = file();
+    steps.integrator.raymarch.steps += 1;
+    for (what, other) in [("spp", spp), ("a light", light), ("an option", steps)] {
+        assert_ne!(print(&a), print(&other), "{what} changed");
+    }
+}

@@ -1,0 +1,409 @@
+//! Partial renders: the exact sums of some samples of some rows of an image,
+//! written as an EXR file that `merge` adds up, and `--resume` continues.
+//!
+//! A partial file holds, for each pixel of its band of rows, the
+//! accumulator's fixed-point sums ([`PixelSum`]) losslessly as 32-bit
+//! unsigned channels: `S<c>0`..`S<c>3` for the sum of channel c (R, G, B),
+//! lowest word first, `Q<c>0`..`Q<c>3` for the sum of squares, and `N0`,
+//! `N1` for the sample count. Text attributes in the header say what the
+//! sums are of ([`PartialHeader`]): the Airlight version, a fingerprint of
+//! the resolved scene, the seed, the image size, the total spp, the sample
+//! range, the band of rows and the frame. Since each sample's random
+//! stream is keyed by (seed, pixel, sample number) and the sums are exact
+//! integers, parts that together hold every sample of every pixel once add
+//! up to the very sums one render makes: the merged image is the same, bit
+//! for bit.
+
+use super::Accumulator;
+use std::io;
+use std::ops::Range;
+use std::path::Path;
+
+/// The format tag written in every partial file.
+pub const PARTIAL_FORMAT: &str = "airlight-partial-1";
+
+/// What a partial file's sums are of.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PartialHeader {
+    /// The Airlight version that rendered it.
+    pub version: String,
+    /// Fingerprint of the resolved scene and integrator (command-line
+    /// overrides applied), as 16 hexadecimal digits.
+    pub scene: String,
+    pub seed: u64,
+    pub width: u32,
+    pub height: u32,
+    /// Samples per pixel of the whole render.
+    pub spp: u32,
+    /// The sample numbers held, within 0..spp.
+    pub samples: Range<u64>,
+    /// The rows held, within 0..height.
+    pub rows: Range<u32>,
+    /// Frame k of n of an animation, if it is one.
+    pub frame: Option<(u32, u32)>,
+    /// How a PNG of the merged image is made: the scene's exposure (stops)
+    /// and tone curve.
+    pub exposure: f32,
+    pub tonemap: super::Tonemap,
+}
+
+/// A partial render: its header and its sums.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Partial {
+    pub header: PartialHeader,
+    pub sums: Accumulator,
+}
+
+const CHANNELS: [char; 3] = ['R', 'G', 'B'];
+
+impl Partial {
+    /// Encodes the partial as EXR bytes (ZIP, lines in increasing order, so
+    /// the bytes are the same whatever the thread count).
+    pub fn encode(&self) -> io::Result<Vec<u8>> {
+        use exr::prelude::*;
+        let h = &self.header;
+        let (w, rows) = (h.width as usize, (h.rows.end - h.rows.start) as usize);
+        let pixels = self.sums.pixels();
+        if pixels.len() != w * rows {
+            return Err(io::Error::other("partial sums do not match their header's size"));
+        }
+        let word = |v: i128, k: u32| (v as u128 >> (32 * k)) as u32;
+        let mut list = Vec::new();
+        for (c, name) in CHANNELS.iter().enumerate() {
+            for k in 0..4 {
+                let sum = pixels.iter().map(|p| word(p.sum[c], k)).collect();
+                list.push(AnyChannel::new(format!("S{name}{k}").as_str(), FlatSamples::U32(sum)));
+                let squares = pixels.iter().map(|p| word(p.sum_squares[c], k)).collect();
+                list.push(AnyChannel::new(format!("Q{name}{k}").as_str(), FlatSamples::U32(squares)));
+            }
+        }
+        for k in 0..2 {
+            let count = pixels.iter().map(|p| (p.count >> (32 * k)) as u32).collect();
+            list.push(AnyChannel::new(format!("N{k}").as_str(), FlatSamples::U32(count)));
+        }
+        let mut attributes = LayerAttributes::named("airlight-partial");
+        for (key, value) in header_fields(h) {
+            let text = Text::new_or_none(&value).ok_or_else(|| io::Error::other("non-ASCII header"))?;
+            attributes.other.insert(Text::new_or_panic(key), AttributeValue::Text(text));
+        }
+        let encoding =
+            Encoding { compression: Compression::ZIP16, blocks: Blocks::ScanLines, line_order: LineOrder::Increasing };
+        let layer = Layer::new((w, rows), attributes, encoding, AnyChannels::sort(list.into()));
+        let mut out = io::Cursor::new(Vec::new());
+        exr::prelude::Image::from_layer(layer).write().to_buffered(&mut out).map_err(io::Error::other)?;
+        Ok(out.into_inner())
+    }
+
+    /// Writes the partial to `path`, whole or not at all.
+    pub fn write(&self, path: &Path) -> io::Result<()> {
+        super::write_atomically(path, &self.encode()?)
+    }
+
+    /// Reads a partial file; the error says what is wrong with it (not an
+    /// EXR, truncated, not a partial, a field missing or out of range).
+    pub fn read(path: &Path) -> Result<Partial, String> {
+        use exr::prelude::*;
+        let meta = exr::meta::MetaData::read_from_file(path, false).map_err(|e| format!("not a readable EXR: {e}"))?;
+        let header = meta.headers.first().ok_or("an EXR without layers")?;
+        let header = parse_header(&header.own_attributes.other)?;
+        let size = header.width as u64 * (header.rows.end - header.rows.start) as u64;
+        let image = read()
+            .no_deep_data()
+            .largest_resolution_level()
+            .all_channels()
+            .first_valid_layer()
+            .all_attributes()
+            .from_file(path)
+            .map_err(|e| format!("cannot read its pixels (truncated or damaged?): {e}"))?;
+        let layer = &image.layer_data;
+        if (layer.size.width() as u64, layer.size.height() as u64)
+            != (header.width as u64, (header.rows.end - header.rows.start) as u64)
+        {
+            return Err(format!(
+                "its pixels are {}×{}, its header says {}×{}",
+                layer.size.width(),
+                layer.size.height(),
+                header.width,
+                header.rows.end - header.rows.start
+            ));
+        }
+        let channel = |name: String| -> std::result::Result<&[u32], String> {
+            let found = layer.channel_data.list.iter().find(|c| c.name.to_string() == name);
+            match found.map(|c| &c.sample_data) {
+                Some(FlatSamples::U32(v)) if v.len() as u64 == size => Ok(v.as_slice()),
+                Some(_) => Err(format!("channel {name} is not 32-bit unsigned of the image's size")),
+                None => Err(format!("channel {name} is missing")),
+            }
+        };
+        let mut sums = Accumulator::band(header.width, header.height, header.rows.clone());
+        let pixels = sums.pixels_mut();
+        for (c, name) in CHANNELS.iter().enumerate() {
+            for k in 0..4 {
+                let (s, q) = (channel(format!("S{name}{k}"))?, channel(format!("Q{name}{k}"))?);
+                for (i, p) in pixels.iter_mut().enumerate() {
+                    p.sum[c] |= ((s[i] as u128) << (32 * k)) as i128;
+                    p.sum_squares[c] |= ((q[i] as u128) << (32 * k)) as i128;
+                }
+            }
+        }
+        let (n0, n1) = (channel("N0".into())?, channel("N1".into())?);
+        for (i, p) in pixels.iter_mut().enumerate() {
+            p.count = n0[i] as u64 | (n1[i] as u64) << 32;
+        }
+        Ok(Partial { header, sums })
+    }
+}
+
+fn header_fields(h: &PartialHeader) -> Vec<(&'static str, String)> {
+    vec![
+        ("airlight.format", PARTIAL_FORMAT.to_string()),
+        ("airlight.version", h.version.clone()),
+        ("airlight.scene", h.scene.clone()),
+        ("airlight.seed", h.seed.to_string()),
+        ("airlight.width", h.width.to_string()),
+        ("airlight.height", h.height.to_string()),
+        ("airlight.spp", h.spp.to_string()),
+        ("airlight.samples", format!("{}..{}", h.samples.start, h.samples.end)),
+        ("airlight.rows", format!("{}..{}", h.rows.start, h.rows.end)),
+        ("airlight.frame", h.frame.map_or("-".into(), |(k, n)| format!("{k}/{n}"))),
+        // Shortest text that reads back as the same f32.
+        ("airlight.exposure", format!("{:?}", h.exposure)),
+        ("airlight.tonemap", h.tonemap.name().to_string()),
+    ]
+}
+
+fn parse_header(
+    attributes: &std::collections::HashMap<exr::meta::attribute::Text, exr::meta::attribute::AttributeValue>,
+) -> Result<PartialHeader, String> {
+    let get = |key: &str| -> Result<String, String> {
+        attributes
+            .iter()
+            .find(|(k, _)| k.to_string() == key)
+            .and_then(|(_, v)| match v {
+                exr::meta::attribute::AttributeValue::Text(t) => Some(t.to_string()),
+                _ => None,
+            })
+            .ok_or_else(|| format!("not an Airlight partial render (no `{key}` in its header)"))
+    };
+    let format = get("airlight.format")?;
+    if format != PARTIAL_FORMAT {
+        return Err(format!("a partial render of format `{format}`; this Airlight reads `{PARTIAL_FORMAT}`"));
+    }
+    let number = |key: &str| -> Result<u64, String> {
+        get(key)?.parse().map_err(|_| format!("its header's `{key}` is not a whole number"))
+    };
+    let range = |key: &str| -> Result<Range<u64>, String> {
+        let text = get(key)?;
+        let (a, b) = text.split_once("..").ok_or_else(|| format!("its header's `{key}` is not a range a..b"))?;
+        let parse = |s: &str| s.parse::<u64>().map_err(|_| format!("its header's `{key}` is not a range a..b"));
+        let (a, b) = (parse(a)?, parse(b)?);
+        if a > b {
+            return Err(format!("its header's `{key}` runs backwards: {a}..{b}"));
+        }
+        Ok(a..b)
+    };
+    let small = |v: u64, key: &str| u32::try_from(v).map_err(|_| format!("its header's `{key}` is too large: {v}"));
+    let (width, height) = (small(number("airlight.width")?, "width")?, small(number("airlight.height")?, "height")?);
+    let spp = small(number("airlight.spp")?, "spp")?;
+    let samples = range("airlight.samples")?;
+    let rows = range("airlight.rows")?;
+    if samples.end > spp as u64 || rows.end > height as u64 {
+        return Err(format!(
+            "its header's samples {samples:?} or rows {rows:?} lie outside the image's {spp} spp or {height} rows"
+        ));
+    }
+    if width as u64 * (rows.end - rows.start) > crate::scene::MAX_PIXELS {
+        return Err(format!(
+            "its header declares {width}×{} pixels, more than Airlight renders",
+            rows.end - rows.start
+        ));
+    }
+    let frame = match get("airlight.frame")?.as_str() {
+        "-" => None,
+        text => {
+            let bad = || format!("its header's frame `{text}` is not k/n");
+            let (k, n) = text.split_once('/').ok_or_else(bad)?;
+            Some((k.parse().map_err(|_| bad())?, n.parse().map_err(|_| bad())?))
+        }
+    };
+    let exposure = get("airlight.exposure")?
+        .parse::<f32>()
+        .ok()
+        .filter(|e| e.is_finite())
+        .ok_or("its header's `airlight.exposure` is not a finite number")?;
+    let tonemap = get("airlight.tonemap")?.parse().map_err(|e| format!("its header's `airlight.tonemap`: {e}"))?;
+    Ok(PartialHeader {
+        exposure,
+        tonemap,
+        version: get("airlight.version")?,
+        scene: get("airlight.scene")?,
+        seed: number("airlight.seed")?,
+        width,
+        height,
+        spp,
+        samples,
+        rows: rows.start as u32..rows.end as u32,
+        frame,
+    })
+}
+
+/// Adds up partial renders of one image, after checking that they are of
+/// the same scene, seed, size, spp and frame, and that together they hold
+/// every sample of every pixel exactly once. `parts` pairs each partial
+/// with the name it is reported by (its file). The error names what is
+/// mismatched, missing or held twice.
+pub fn merge(parts: &[(String, Partial)]) -> Result<(PartialHeader, Accumulator), String> {
+    let Some((first_name, first)) = parts.first() else {
+        return Err("no partial renders to merge".into());
+    };
+    let a = &first.header;
+    for (name, part) in &parts[1..] {
+        let b = &part.header;
+        let differ = |what: &str, x: &dyn std::fmt::Display, y: &dyn std::fmt::Display| {
+            Err(format!("{name} and {first_name} are of different renders: {what} {y} and {x}"))
+        };
+        if b.seed != a.seed {
+            return differ("seed", &a.seed, &b.seed);
+        }
+        if (b.width, b.height) != (a.width, a.height) {
+            return differ("size", &format!("{}×{}", a.width, a.height), &format!("{}×{}", b.width, b.height));
+        }
+        if b.spp != a.spp {
+            return differ("spp", &a.spp, &b.spp);
+        }
+        if b.frame != a.frame {
+            return differ("frame", &format!("{:?}", a.frame), &format!("{:?}", b.frame));
+        }
+        if b.version != a.version {
+            return differ("Airlight version", &a.version, &b.version);
+        }
+        // Last: the fingerprint covers the fields above too, which are
+        // named more plainly on their own.
+        if b.scene != a.scene {
+            return differ("scene fingerprint", &a.scene, &b.scene);
+        }
+    }
+    check_coverage(parts, a.height, a.spp as u64)?;
+    let mut total = Accumulator::new(a.width, a.height);
+    for (name, part) in parts {
+        total.merge(&part.sums).map_err(|e| format!("{name}: {e}"))?;
+    }
+    let header = PartialHeader { samples: 0..a.spp as u64, rows: 0..a.height, ..a.clone() };
+    Ok((header, total))
+}
+
+/// Checks that the parts' rectangles (rows × sample numbers) tile
+/// [0, height) × [0, spp) exactly.
+fn check_coverage(parts: &[(String, Partial)], height: u32, spp: u64) -> Result<(), String> {
+    let mut cuts: Vec<u32> = vec![0, height];
+    for (_, p) in parts {
+        cuts.extend([p.header.rows.start, p.header.rows.end]);
+    }
+    cuts.sort_unstable();
+    cuts.dedup();
+    for band in cuts.windows(2) {
+        let (r0, r1) = (band[0], band[1]);
+        let mut spans: Vec<(u64, u64, &str)> = parts
+            .iter()
+            .filter(|(_, p)| p.header.rows.start <= r0 && p.header.rows.end >= r1)
+            .filter(|(_, p)| !p.header.samples.is_empty())
+            .map(|(name, p)| (p.header.samples.start, p.header.samples.end, name.as_str()))
+            .collect();
+        spans.sort_unstable();
+        let mut next = 0u64;
+        let mut last_name = "";
+        for (s0, s1, name) in spans {
+            if s0 > next {
+                return Err(format!("samples {next}..{s0} of rows {r0}..{r1} are in no part"));
+            }
+            if s0 < next {
+                return Err(format!(
+                    "{name} and {last_name} both hold samples {s0}..{} of rows {r0}..{r1}",
+                    next.min(s1)
+                ));
+            }
+            next = s1;
+            last_name = name;
+        }
+        if next < spp {
+            return Err(format!("samples {next}..{spp} of rows {r0}..{r1} are in no part"));
+        }
+    }
+    Ok(())
+}
+
+/// The `k`-th of `n` contiguous, near-equal pieces of `0..total` (the
+/// first `total % n` pieces one longer).
+pub fn piece(total: u64, k: u64, n: u64) -> Range<u64> {
+    let (base, extra) = (total / n, total % n);
+    let start = k * base + k.min(extra);
+    start..start + base + u64::from(k < extra)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::Rgb;
+
+    fn part(rows: Range<u32>, samples: Range<u64>, seed: u64) -> Partial {
+        let mut sums = Accumulator::band(3, 4, rows.clone());
+        let first = rows.start as usize * 3;
+        for (i, p) in sums.pixels_mut().iter_mut().enumerate() {
+            for s in samples.clone() {
+                p.add(Rgb::new((first + i) as f32 + 0.25, s as f32 * 1e-3, -1.5e7));
+            }
+        }
+        let header = PartialHeader {
+            version: "0.1.0".into(),
+            scene: "0123456789abcdef".into(),
+            seed,
+            width: 3,
+            height: 4,
+            spp: 5,
+            samples,
+            rows,
+            frame: Some((1, 3)),
+            exposure: -0.5,
+            tonemap: crate::film::Tonemap::Filmic,
+        };
+        Partial { header, sums }
+    }
+
+    #[test]
+    fn a_partial_file_round_trips_exactly() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("p.exr");
+        let p = part(1..3, 2..5, 7);
+        p.write(&path).unwrap();
+        assert_eq!(Partial::read(&path).unwrap(), p);
+    }
+
+    #[test]
+    fn pieces_split_evenly_and_cover_the_whole() {
+        for (total, n) in [(10u64, 3u64), (7, 7), (3, 4), (1000, 7)] {
+            let ranges: Vec<_> = (0..n).map(|k| piece(total, k, n)).collect();
+            assert_eq!(ranges[0].start, 0);
+            assert_eq!(ranges[n as usize - 1].end, total);
+            assert!(ranges.windows(2).all(|w| w[0].end == w[1].start));
+            let sizes: Vec<u64> = ranges.iter().map(|r| r.end - r.start).collect();
+            assert!(sizes.iter().max().unwrap() - sizes.iter().min().unwrap() <= 1, "{sizes:?}");
+        }
+    }
+
+    #[test]
+    fn merging_checks_coverage_and_sameness() {
+        let named = |parts: Vec<Partial>| -> Vec<(String, Partial)> {
+            parts.into_iter().enumerate().map(|(i, p)| (format!("part{i}"), p)).collect()
+        };
+        let whole = part(0..4, 0..5, 7);
+        let split = named(vec![part(0..2, 0..5, 7), part(2..4, 0..3, 7), part(2..4, 3..5, 7)]);
+        let (_, merged) = merge(&split).unwrap();
+        assert_eq!(merged, whole.sums);
+        let missing = merge(&named(vec![part(0..2, 0..5, 7), part(2..4, 0..3, 7)])).unwrap_err();
+        assert!(missing.contains("samples 3..5 of rows 2..4 are in no part"), "{missing}");
+        let overlap = merge(&named(vec![part(0..4, 0..5, 7), part(2..4, 1..2, 7)])).unwrap_err();
+        assert!(overlap.contains("both hold samples 1..2 of rows 2..4"), "{overlap}");
+        let seed = merge(&named(vec![part(0..2, 0..5, 7), part(2..4, 0..5, 8)])).unwrap_err();
+        assert!(seed.contains("seed 8 and 7"), "{seed}");
+    }
+}
