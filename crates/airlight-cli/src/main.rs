@@ -12,6 +12,7 @@ mod merge;
 mod plot;
 mod progress;
 mod render;
+mod submit;
 mod view;
 
 /// The built-in demo scene: spheres on a checker floor under a spot light in fog.
@@ -43,6 +44,10 @@ enum Command {
     View(view::ViewArgs),
     /// Add up partial renders (`render --shard/--tile`) into the image.
     Merge(merge::MergeArgs),
+    /// Render on a cluster's scheduler: shards, tiles and frames as a job
+    /// array, then a merge job.
+    #[command(subcommand)]
+    Submit(Submit),
     /// Compare two EXR images: prints rmse, rel_mse, mae and max.
     Compare {
         image: PathBuf,
@@ -51,6 +56,13 @@ enum Command {
         #[arg(long, value_name = "OUT.png")]
         map: Option<PathBuf>,
     },
+}
+
+#[derive(Subcommand)]
+enum Submit {
+    /// Submit to Slurm: a job array of `airlight render --shard/--tile/--frame`
+    /// tasks and a merge job that runs after every task succeeds.
+    Slurm(submit::SlurmArgs),
 }
 
 #[derive(clap::Args)]
@@ -109,6 +121,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Render(args) => render::render(args),
         Command::Merge(args) => merge::merge(args),
+        Command::Submit(Submit::Slurm(args)) => submit::slurm(args),
         Command::Info { scene } => info(&scene),
         Command::Compare { image, reference, map } => compare(&image, &reference, map.as_deref()),
         Command::Attenuation(args) => attenuation(args),

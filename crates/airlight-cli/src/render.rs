@@ -106,7 +106,7 @@ struct FrameOutputs {
 
 /// What one `render` command computes: which frames, which samples of
 /// which rows, and whether as a partial render.
-struct Plan {
+pub struct Plan {
     /// Frame numbers to render, with the count; None for a still image.
     frames: Option<(Vec<u32>, u32)>,
     samples: Range<u64>,
@@ -160,23 +160,30 @@ impl Plan {
     }
 }
 
-pub fn render(args: RenderArgs) -> Result<(), String> {
-    let SceneFile { mut scene, integrator: desc } = configure(&args)?;
-    // Of the scene as resolved, before any frame moves its lights.
-    let fingerprint = airlight::fingerprint(&scene, &desc);
-    let plan = Plan::new(&args, &scene)?;
-    let outputs = output_paths(&args)?;
+/// Everything `render` checks before it renders: the scene with the
+/// command line's overrides, what to render, and where it goes.
+pub fn prepare(args: &RenderArgs) -> Result<(SceneFile, Plan, Vec<PathBuf>), String> {
+    let file = configure(args)?;
+    let plan = Plan::new(args, &file.scene)?;
+    let outputs = output_paths(args)?;
     if let Some(v) = &args.variance
         && !v.extension().is_some_and(|e| e.eq_ignore_ascii_case("exr"))
     {
         return Err(format!("cannot write `{}`: the variance is written as .exr", v.display()));
     }
-    if args.variance.is_some() && scene.settings().spp < 2 {
+    if args.variance.is_some() && file.scene.settings().spp < 2 {
         return Err("--variance: a variance needs at least 2 samples per pixel (--spp)".into());
     }
-    if args.frames.is_some() && !scene.is_animated() {
+    if args.frames.is_some() && !file.scene.is_animated() {
         return Err("--frames: the scene has no light with keyframes to animate".into());
     }
+    Ok((file, plan, outputs))
+}
+
+pub fn render(args: RenderArgs) -> Result<(), String> {
+    let (SceneFile { mut scene, integrator: desc }, plan, outputs) = prepare(&args)?;
+    // Of the scene as resolved, before any frame moves its lights.
+    let fingerprint = airlight::fingerprint(&scene, &desc);
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(args.threads.unwrap_or(0) as usize)
         .build()
@@ -321,7 +328,7 @@ fn output_paths(args: &RenderArgs) -> Result<Vec<PathBuf>, String> {
 }
 
 /// `path` with `_NNNN` (the frame number) before its extension.
-fn numbered(path: &Path, frame: u32) -> PathBuf {
+pub fn numbered(path: &Path, frame: u32) -> PathBuf {
     let stem = path.file_stem().unwrap_or_default().to_string_lossy();
     let name = match path.extension() {
         Some(ext) => format!("{stem}_{frame:04}.{}", ext.to_string_lossy()),

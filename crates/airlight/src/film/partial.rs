@@ -178,7 +178,7 @@ fn parse_header(
     let get = |key: &str| -> Result<String, String> {
         attributes
             .iter()
-            .find(|(k, _)| k.to_string() == key)
+            .find(|(k, _)| *k == key)
             .and_then(|(_, v)| match v {
                 exr::meta::attribute::AttributeValue::Text(t) => Some(t.to_string()),
                 _ => None,
