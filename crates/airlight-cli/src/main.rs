@@ -73,7 +73,7 @@ struct AttenuationArgs {
     /// Its intensity in W/sr (a sphere light of radiance L has π r² L).
     #[arg(long, default_value_t = 10.0)]
     intensity: f32,
-    /// Irradiance below which light is dropped (the seed's I_c); sets d_max.
+    /// Irradiance below which light is dropped (Madams's I_c); sets d_max.
     #[arg(long, default_value_t = 0.05)]
     cutoff: f32,
     /// d_max for the windows, overriding the one the cutoff implies.

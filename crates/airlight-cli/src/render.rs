@@ -87,7 +87,7 @@ pub struct RenderArgs {
     /// analytic: points per dimension over line and quad lights.
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=4096))]
     light_steps: Option<u32>,
-    /// analytic: gauss (Gauss–Legendre) or uniform (the seed's stepping) over lights.
+    /// analytic: gauss (Gauss–Legendre) or uniform (equal steps) over lights.
     #[arg(long, value_parser = parse_light_quadrature)]
     light_quadrature: Option<LightQuadrature>,
     /// Worker threads (default: all cores). The image does not depend on it.

@@ -45,7 +45,7 @@ fn main() {
         _ => (320, 240, 4096),
     };
     let strategies = [
-        ("uniform, independent (the seed)", Sampling::Uniform, false),
+        ("uniform, independent (Hoff)", Sampling::Uniform, false),
         ("uniform, stratified", Sampling::Uniform, true),
         ("equiangular, independent", Sampling::Equiangular, false),
         ("equiangular, stratified", Sampling::Equiangular, true),
@@ -98,7 +98,7 @@ fn main() {
         let target = rows[0].1[SPPS.len() - 1];
         let reached = rows[3].1.iter().zip(SPPS).find(|(e, _)| **e <= target).map(|(_, s)| s);
         println!(
-            "\nUniform (the seed's estimator) at 64 spp: {target:.4}. Equiangular + stratified reaches it at {} spp.",
+            "\nUniform (Hoff's estimator) at 64 spp: {target:.4}. Equiangular + stratified reaches it at {} spp.",
             reached.map_or("more than 64".to_string(), |s| s.to_string())
         );
     }

@@ -13,7 +13,7 @@ pub enum Material {
     /// Diffuse plus a normalised Phong lobe (Lafortune and Willems 1994):
     /// f = albedo/π + specular·(n+2)/(2π)·max(0, r·wi)^n, r the mirror of wo.
     /// The (n+2)/(2π) makes the lobe's directional albedo at normal
-    /// incidence equal `specular`, as in the seed's setUpPhongIllumination.
+    /// incidence equal `specular`, as in the ray-marching post's setUpPhongIllumination.
     Phong { albedo: Rgb, specular: Rgb, exponent: f32 },
 }
 

@@ -1,7 +1,7 @@
 //! The analytic integrator's closed forms against numeric integrals written
 //! here, independently of the code under test: adaptive Simpson in f64 over
 //! the integrand as the physics states it (1/|o + t d − P|² and its
-//! attenuated form), never through the seed's coordinates or the special
+//! attenuated form), never through Packard's coordinates or the special
 //! functions.
 
 use airlight::integrator::analytic::{

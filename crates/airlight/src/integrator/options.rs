@@ -132,7 +132,7 @@ pub struct RadiosityOptions {
     /// Side length (world units) surfaces are cut into patches of; None
     /// picks 1/32 of the largest extent of the bounded geometry.
     pub patch_size: Option<f32>,
-    /// Bounces of indirect light (1 = one bounce, as in the seed technique).
+    /// Bounces of indirect light (1 = one bounce, as in Madams technique).
     pub bounces: u32,
     /// A patch links to a whole cluster instead of its children when the
     /// cluster's estimated form factor A/(π d²) is below this; 0 links

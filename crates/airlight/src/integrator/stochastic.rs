@@ -1,5 +1,5 @@
 //! Monte Carlo single scattering, after Anders Hoff's "Volumetric Light"
-//! (inconvergent.net, "the seed" below): per pixel sample, a point x on the
+//! (inconvergent.net, "Hoff" below): per pixel sample, a point x on the
 //! camera segment [eye, hit] and a point y in the light; if the path between
 //! them is clear, add the light scattered at x toward the eye.
 //!
@@ -12,8 +12,8 @@
 //! f(t, y)/(pdf(t | y)·pdf(y)), with y from the light's own sampling and t from
 //! one of three strategies:
 //!
-//! - `uniform`: pdf(t) = 1/t_end, the seed's `line_sample`. With a volume
-//!   light the seed's sum d/(1 + dist)² is this estimator with its fudge
+//! - `uniform`: pdf(t) = 1/t_end, Hoff's `line_sample`. With a volume
+//!   light Hoff's sum d/(1 + dist)² is this estimator with its fudge
 //!   factors (the "+1", the unknown scale) replaced by the physical ones.
 //! - `equiangular`: pdf(t) ∝ 1/r² toward the light's anchor point (the point
 //!   light itself, or the centre of an extended light with its size as the
@@ -25,9 +25,9 @@
 //! With `stratify`, each sample's numbers (film, lens, t and light point) are
 //! its point of the pixel's Owen-scrambled Sobol' sequence (sampling/sobol.rs),
 //! one independent 4D group for the camera and one per light; without, they are
-//! independent random numbers, as in the seed.
+//! independent random numbers, as in Hoff.
 //!
-//! Rays that hit nothing end at `max_distance`, on the seed's "very large
+//! Rays that hit nothing end at `max_distance`, on Hoff's "very large
 //! plane" facing the camera, whose radiance is `background`.
 
 use super::equiangular::Equiangular;
@@ -42,7 +42,7 @@ use glam::Vec3;
 /// How the point on the camera segment is drawn.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
 pub enum Sampling {
-    /// Uniform in distance (the seed's estimator).
+    /// Uniform in distance (Hoff's estimator).
     Uniform,
     /// In proportion to 1/r² toward the light (Kulla and Fajardo 2012).
     #[default]

@@ -7,7 +7,7 @@
 //! distance d from its surface (D = d + r from its centre),
 //! E = E₀ · f(d) with E₀ = I / r², the irradiance at its surface. Every curve
 //! f below is 1 at d = 0. The physical law is f = r² / D² = 1/(d/r + 1)²,
-//! which is the seed's finding: its attenuation curve for a sphere of radius
+//! which is Madams's finding: its attenuation curve for a sphere of radius
 //! r is the inverse-square law measured from the centre, in units of r
 //! (k_c = 1, k_l = 2/r, k_q = 1/r²).
 
@@ -19,16 +19,16 @@ pub enum AttenuationModel {
     /// (sampled over the cone it subtends), with soft shadows.
     #[default]
     Physical,
-    /// The seed's 1/(d/r + 1)², evaluated as a point at the centre (for a
+    /// Madams's 1/(d/r + 1)², evaluated as a point at the centre (for a
     /// sphere light: no horizon clipping, hard shadows).
     Sphere,
-    /// The seed's bias and scale: (f − c)/(1 − c), c = I_c/E₀, clamped at 0,
+    /// Madams's bias and scale: (f − c)/(1 − c), c = I_c/E₀, clamped at 0,
     /// reaching 0 at d_max = r(√(E₀/I_c) − 1).
     Cutoff,
-    /// f(d') with d' = (2 d_max/π) tan(π d/(2 d_max)) (the seed's tan window;
+    /// f(d') with d' = (2 d_max/π) tan(π d/(2 d_max)) (Madams's tan window;
     /// its constant 2.1 is replaced by 2 d_max/π so that d' ≈ d near the light).
     WindowTan,
-    /// f(d') with d' = d / (1 − (d/d_max)²) (the seed's rational window).
+    /// f(d') with d' = d / (1 − (d/d_max)²) (Madams's rational window).
     WindowRational,
     /// Karis (2013), Unreal Engine 4: saturate(1 − (d/d_max)⁴)² / ((d/r)² + 1),
     /// distance in light radii (with r = 1 it is his formula).
@@ -113,14 +113,14 @@ impl Attenuation {
     }
 }
 
-/// The seed's sphere-light attenuation, 1/(d/r + 1)² = r²/(d + r)².
+/// Madams's sphere-light attenuation, 1/(d/r + 1)² = r²/(d + r)².
 #[inline]
 pub fn sphere_falloff(d: f32, r: f32) -> f32 {
     let x = d / r + 1.0;
     1.0 / (x * x)
 }
 
-/// The seed's range for a cutoff c = I_c/E₀: where 1/(d/r + 1)² = c.
+/// Madams's range for a cutoff c = I_c/E₀: where 1/(d/r + 1)² = c.
 pub fn cutoff_range(r: f32, relative_cutoff: f32) -> f32 {
     if relative_cutoff <= 0.0 {
         return f32::INFINITY;
@@ -128,7 +128,7 @@ pub fn cutoff_range(r: f32, relative_cutoff: f32) -> f32 {
     (r * ((1.0 / relative_cutoff).sqrt() - 1.0)).max(0.0)
 }
 
-/// The seed's bias and scale: (f − c)/(1 − c), clamped at 0.
+/// Madams's bias and scale: (f − c)/(1 − c), clamped at 0.
 #[inline]
 pub fn cutoff_falloff(d: f32, r: f32, c: f32) -> f32 {
     if c >= 1.0 {
@@ -186,10 +186,10 @@ mod tests {
             let d_max = a.range;
             assert!(
                 (d_max - r * ((e0 / 0.05f32).sqrt() - 1.0)).abs() < 1e-3 * d_max,
-                "{model:?}: range from the seed's formula"
+                "{model:?}: range from Madams's formula"
             );
             // Value 0 at d_max, and the derivative there by a one-sided
-            // difference: ~0 (cutoff's is not, which is the seed's point).
+            // difference: ~0 (cutoff's is not, which is Madams's point).
             assert_eq!(a.factor(d_max), 0.0);
             let h = 1e-3 * d_max;
             let slope = (a.factor(d_max) - a.factor(d_max - h)) / h;

@@ -101,7 +101,7 @@ fn spot_profiles_match_their_definitions() {
 
 #[test]
 fn seed_sphere_attenuation_is_exact_for_a_facing_point() {
-    // The seed's 1/(d/r + 1)² in Airlight's normalisation, E = πL·f(d),
+    // Madams's 1/(d/r + 1)² in Airlight's normalisation, E = πL·f(d),
     // equals the closed form πL(r/D)² on a point facing the sphere, and the
     // cone-sampled exact light agrees.
     let (r, l) = (0.4f32, 3.0f32);

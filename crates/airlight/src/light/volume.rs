@@ -1,4 +1,4 @@
-//! Volume lights: a region of air that glows, as the seed's light cube.
+//! Volume lights: a region of air that glows, as Hoff's light cube.
 //!
 //! Units: a volume light of `intensity` I (W/sr) emits like a point light of
 //! intensity I spread uniformly over its volume V: every volume element dV

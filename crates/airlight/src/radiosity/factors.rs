@@ -1,6 +1,6 @@
 //! Form factors between patches, and their visibility.
 //!
-//! The form factor from a patch i to a patch j is the seed's
+//! The form factor from a patch i to a patch j is Madams's
 //!
 //!   F_ij = cos φi · cos φj / (π r²) · A_j,
 //!

@@ -3,7 +3,7 @@
 //! Form factors are in [`super::factors`].
 //!
 //! Links follow Hanrahan, Salzman and Aupperle, "A Rapid Hierarchical
-//! Radiosity Algorithm" (SIGGRAPH 1991), with clusters (the seed's k-means
+//! Radiosity Algorithm" (SIGGRAPH 1991), with clusters (Madams's k-means
 //! hierarchy) as sources: refinement starts from (root, root); a pair where
 //! one side lies wholly behind the other is dropped (`behind`); two
 //! patches are linked by their form factor; otherwise the pair is linked as

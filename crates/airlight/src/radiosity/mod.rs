@@ -1,4 +1,4 @@
-//! Radiosity global illumination with a patch hierarchy, after the seed
+//! Radiosity global illumination with a patch hierarchy, after Madams
 //! (Tom Madams's blog post on real-time radiosity, 2011).
 //!
 //! A static scene is compiled once ([`Radiosity::compile`]): its surfaces are
@@ -11,7 +11,7 @@
 //!
 //!   E¹_i = Σ_j F_ij B⁰_j,  B⁰_j = ρ_j E⁰_j,
 //!
-//! the seed's I_i = Σ_j D_j F_ij with D_j = ρ_j E⁰_j. `bounces = N` repeats
+//! Madams's I_i = Σ_j D_j F_ij with D_j = ρ_j E⁰_j. `bounces = N` repeats
 //! push and gather N times (Eᵏ⁺¹_i = Σ_j F_ij ρ_j Eᵏ_j, a Jacobi iteration of
 //! the radiosity equation, Cohen and Wallace 1993 §5), and the indirect
 //! irradiance kept per patch is E¹ + … + E^N. Moving a light, changing its
@@ -21,7 +21,7 @@
 //! reflects radiance L = ρE/π, and its radiosity (exitance) is B = πL = ρE.
 //! The integrator ([`crate::integrator::RadiosityIntegrator`]) evaluates
 //! direct light per pixel and adds the indirect part ρ(p)/π · E_ind(p), with
-//! E_ind interpolated between patch centres ([`lookup`]): the seed's "direct
+//! E_ind interpolated between patch centres ([`lookup`]): Madams's "direct
 //! and indirect illumination at different frequencies". Patches exchange
 //! light in vacuum; a medium attenuates only the camera ray and the per-pixel
 //! direct light. The diffuse albedo of a Phong material bounces; its specular
@@ -80,7 +80,7 @@ pub struct CompileParams {
     /// two-sided refinement) when flat (normals within ~18°) and their own
     /// estimated form factor is below `receiver_share × link_threshold`; the
     /// irradiance a cluster gathers is handed down to its patches. 0 (the
-    /// default) lets only patches receive, as the seed does: on the Cornell
+    /// default) lets only patches receive, as Madams does: on the Cornell
     /// box receiver clusters saved fewer links than they cost in accuracy.
     pub receiver_share: f32,
     /// Seeds the clustering and the sample positions.

@@ -3,15 +3,15 @@
 //! A ray o + t·d (d unit) passes a point light at P. Let h = d·(P − o) be the
 //! parameter of the foot of the perpendicular from P to the ray's line and
 //! p = |P − o − h·d| the light's distance from that line (Packard 2004,
-//! "Efficient Rendering of Glowing Lights", the seed
+//! "Efficient Rendering of Glowing Lights", Packard
 //! 2004). With y = t − h, the distance to the
 //! light is r(t) = √(p² + y²). For an isotropic light of intensity I in a
 //! homogeneous medium the single-scattered radiance over t in [t₀, t₁] is
 //!
 //!   L = σs · phase · I · ∫_{t₀}^{t₁} e^{−σt (t + r(t))} / r(t)² dt.
 //!
-//! Without extinction (σt = 0 along the way, the seed's assumption) the
-//! integral is the seed's atan form, [`glow_vacuum`]. With extinction it is
+//! Without extinction (σt = 0 along the way, Packard's assumption) the
+//! integral is Packard's atan form, [`glow_vacuum`]. With extinction it is
 //! Sun, Ramamoorthi, Narasimhan and Nayar's (SIGGRAPH 2005) special function
 //! F(u, v) = ∫₀^v e^{−u tan ξ} dξ, here evaluated exactly through the
 //! complex exponential integral ([`Glow`], [`sun_f`]).
@@ -29,11 +29,11 @@ use glam::{DVec3, Vec3};
 /// value that f32 input can distinguish from a light exactly on the line.
 pub const P_FLOOR: f64 = 1e-9;
 
-/// The seed's a, b, p for a light at `light`, a ray from `origin` along the
+/// Packard's a, b, p for a light at `light`, a ray from `origin` along the
 /// unit vector `dir`, and the segment [0, t_end]: with the foot
 /// Z = O + D (D·(P − O)), p = |P − Z|, and a, b the signed positions of the
 /// segment's ends measured along the ray from Z: a = −D·(P − O) and
-/// b = t_end − D·(P − O). The seed writes a = −|O − Z| and b = |O + T·D − Z|,
+/// b = t_end − D·(P − O). Packard writes a = −|O − Z| and b = |O + T·D − Z|,
 /// which are these values when the foot lies within the segment (a ≤ 0 ≤ b);
 /// the signed form covers a foot before the origin or past the end as well.
 pub fn seed_coordinates(light: DVec3, origin: DVec3, dir: DVec3, t_end: f64) -> (f64, f64, f64) {
@@ -43,7 +43,7 @@ pub fn seed_coordinates(light: DVec3, origin: DVec3, dir: DVec3, t_end: f64) -> 
     (-h, t_end - h, p)
 }
 
-/// ∫_a^b dy / (p² + y²) = (atan(b/p) − atan(a/p)) / p, the seed's closed
+/// ∫_a^b dy / (p² + y²) = (atan(b/p) − atan(a/p)) / p, Packard's closed
 /// form (its sign convention reversed so that a < b gives a positive value),
 /// evaluated as atan2(p (b − a), p² + a b) / p, which has no cancellation
 /// when a and b are large and of one sign. For p → 0 with the foot outside
@@ -98,7 +98,7 @@ fn y_plus_r(p: f64, y: f64) -> f64 {
 ///   K(t) = (2/p) e^{−σt (t + r)} Im S(σt (y + r) − i σt p),
 ///
 /// whose exponential never overflows (t + r ≥ 0 for t ≥ 0). For σt → 0,
-/// Im S → −arg z = π/2 − ξ and K tends to the seed's atan form. When the
+/// Im S → −arg z = π/2 − ξ and K tends to Packard's atan form. When the
 /// two values of K agree to 1e-3 (a short interval: the E₁ evaluation,
 /// good to about 1e-13 of K, would lose digits to cancellation) the difference is
 /// taken instead by 8-point Gauss–Legendre in θ over the piece, where the
@@ -205,7 +205,7 @@ impl Glow {
 }
 
 /// ∫_a^b e^{−σt (y + √(p² + y²))} / (p² + y²) dy: the airlight integral with
-/// extinction in the seed's coordinates (the foot at y = 0; multiply by
+/// extinction in Packard's coordinates (the foot at y = 0; multiply by
 /// e^{−σt h} for a foot at ray parameter h). See [`Glow`].
 pub fn glow_extinction(sigma_t: f64, p: f64, a: f64, b: f64) -> f64 {
     let p = p.max(P_FLOOR * (a.abs() + b.abs())).max(f64::MIN_POSITIVE.sqrt());

@@ -14,7 +14,7 @@
 //! boundaries); on each piece:
 //!
 //! - when phase·m is constant (isotropic phase, inside a spot's inner cone,
-//!   lit), the integral is exact: [`glow_vacuum`] (the seed's atan form) for
+//!   lit), the integral is exact: [`glow_vacuum`] (Packard's atan form) for
 //!   σt = 0, [`Glow`] (Sun et al.'s F through the complex exponential
 //!   integral) for σt > 0. The renderer reads Im S = Im e^z E₁(z), the one
 //!   special function in it, from a table (as Sun et al. tabulate F; see
@@ -33,7 +33,7 @@
 //!   to 1.4e-4 relative RMSE (the march's own error).
 //!
 //! Line and quad lights are sums of such point lights ([`LightQuadrature`],
-//! `light_steps` points per dimension), as the seed superposes them. A fixed
+//! `light_steps` points per dimension), as Packard superposes them. A fixed
 //! set of points fails for rays that pass closer to the light than a few
 //! point spacings (each point then shows its own glow), so per ray a piece
 //! of the light that the ray passes close to is halved (line, up to 8
@@ -108,7 +108,7 @@ pub enum LightQuadrature {
     /// Gauss–Legendre nodes and weights along each edge.
     #[default]
     Gauss,
-    /// The seed's uniform stepping: the middles of equal cells, equal weights.
+    /// Packard's uniform stepping: the middles of equal cells, equal weights.
     Uniform,
 }
 

@@ -1,4 +1,4 @@
-//! Gauss–Legendre quadrature, and the seed's uniform stepping, on [0, 1].
+//! Gauss–Legendre quadrature, and Packard's uniform stepping, on [0, 1].
 
 use std::sync::OnceLock;
 
@@ -46,7 +46,7 @@ impl Rule {
         Rule { nodes, weights }
     }
 
-    /// The seed's uniform stepping: n equal cells, one point at the middle of
+    /// Packard's uniform stepping: n equal cells, one point at the middle of
     /// each, weight 1/n (the midpoint rule).
     pub fn uniform(n: usize) -> Rule {
         let n = n.max(1);
