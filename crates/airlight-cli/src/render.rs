@@ -65,6 +65,11 @@ pub struct RenderArgs {
     /// EXR for `airlight merge`; combines with --shard.
     #[arg(long, value_name = "K/N", value_parser = parse_part)]
     tile: Option<(u32, u32)>,
+    /// With --progressive: continue the render whose samples so far are kept
+    /// beside the output (NAME.partial.exr, rewritten after every pass); the
+    /// finished image is the one an uninterrupted render gives, bit for bit.
+    #[arg(long, requires = "progressive")]
+    resume: bool,
     /// Samples per pixel.
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
     spp: Option<u32>,
@@ -213,23 +218,25 @@ pub fn render(args: RenderArgs) -> Result<(), String> {
         };
         let frame_label = frame.map(|(k, n)| format!(" frame {k} of {n}")).unwrap_or_default();
         let label = format!("{}{frame_label}", desc.kind);
+        let header = PartialHeader {
+            version: env!("CARGO_PKG_VERSION").into(),
+            scene: fingerprint.clone(),
+            seed: scene.settings().seed,
+            width: scene.settings().width,
+            height: scene.settings().height,
+            spp: scene.settings().spp,
+            samples: plan.samples.clone(),
+            rows: plan.rows.clone(),
+            frame,
+            exposure: scene.settings().exposure,
+            tonemap: scene.settings().tonemap,
+        };
         let summary = if plan.partial {
-            let header = PartialHeader {
-                version: env!("CARGO_PKG_VERSION").into(),
-                scene: fingerprint.clone(),
-                seed: scene.settings().seed,
-                width: scene.settings().width,
-                height: scene.settings().height,
-                spp: scene.settings().spp,
-                samples: plan.samples.clone(),
-                rows: plan.rows.clone(),
-                frame,
-                exposure: scene.settings().exposure,
-                tonemap: scene.settings().tonemap,
-            };
             render_partial(&scene, integrator.as_ref(), &pool, &progress, &outputs.images[0], header, &label)?
         } else if progressive {
-            render_progressive(&scene, integrator.as_ref(), &pool, &progress, &outputs, args.target_error, &label)?
+            let state = State { path: state_path(&outputs.images[0]), header, resume: args.resume };
+            let target = args.target_error;
+            render_progressive(&scene, integrator.as_ref(), &pool, &progress, &outputs, target, &state, &label)?
         } else {
             render_once(&scene, integrator.as_ref(), &pool, &progress, &outputs, &label)?
         };
@@ -382,9 +389,54 @@ fn render_partial(
     Ok(String::new())
 }
 
-/// Passes of doubling size, each rewriting the outputs (atomically, so
-/// stopping the render loses at most the pass under way), until spp or the
-/// error target; returns the samples reached and the estimated error.
+/// Where a progressive render keeps its samples so far, and what they are.
+struct State {
+    path: PathBuf,
+    /// The render's header, for any number of samples.
+    header: PartialHeader,
+    /// Continue from the file if it is there.
+    resume: bool,
+}
+
+/// `NAME.partial.exr` beside the output `NAME.png` or `NAME.exr`.
+fn state_path(output: &Path) -> PathBuf {
+    let stem = output.file_stem().unwrap_or_default().to_string_lossy();
+    output.with_file_name(format!("{stem}.partial.exr"))
+}
+
+/// The progressive render that `state` holds the first samples of, when
+/// resuming and it is there; it must be of this very render.
+fn resumed(scene: &Scene, state: &State, progress: &Progress) -> Result<Progressive, String> {
+    if !state.resume || !state.path.exists() {
+        if state.resume {
+            progress.println(&format!("--resume: no `{}`, starting from the first sample", state.path.display()));
+        }
+        return Ok(Progressive::new(scene));
+    }
+    let name = state.path.display();
+    let part = Partial::read(&state.path).map_err(|e| format!("--resume: {name}: {e}"))?;
+    let (a, b) = (&part.header, &state.header);
+    if (&a.scene, a.seed, a.width, a.height, a.spp, a.frame) != (&b.scene, b.seed, b.width, b.height, b.spp, b.frame)
+        || a.version != b.version
+    {
+        return Err(format!(
+            "--resume: {name} holds samples of another render (scene, seed, size, spp, frame or Airlight version \
+             differ); remove it to start again"
+        ));
+    }
+    if a.samples.start != 0 || a.rows != (0..b.height) || a.samples.end > b.spp as u64 {
+        return Err(format!("--resume: {name} does not hold the first samples of every row"));
+    }
+    progress.println(&format!("resuming from {} samples per pixel in {name}", a.samples.end));
+    progress.inc(a.samples.end * b.width as u64 * b.height as u64);
+    Ok(Progressive::resume(scene, part.sums, a.samples.end as u32))
+}
+
+/// Passes of doubling size, each rewriting the outputs and the samples so
+/// far (atomically, so stopping the render loses at most the pass under
+/// way), until spp or the error target; returns the samples reached and the
+/// estimated error. The samples-so-far file is removed once done.
+#[allow(clippy::too_many_arguments)]
 fn render_progressive(
     scene: &Scene,
     integrator: &dyn Integrator,
@@ -392,11 +444,16 @@ fn render_progressive(
     progress: &Progress,
     outputs: &FrameOutputs,
     target_error: Option<f64>,
+    state: &State,
     label: &str,
 ) -> Result<String, String> {
     let s = scene.settings();
-    let mut progressive = Progressive::new(scene);
-    let mut error = f64::INFINITY;
+    let mut progressive = resumed(scene, state, progress)?;
+    let mut error = progressive.estimated_relative_error();
+    if progressive.samples() > 0 && (progressive.finished() || target_error.is_some_and(|target| error < target)) {
+        // Stopped after its last pass, before it tidied up: the images again.
+        write_images(scene, &progressive.image(), &outputs.images)?;
+    }
     while !progressive.finished() && !target_error.is_some_and(|target| error < target) {
         let inc = |n: u64| progress.inc(n);
         let observer = RenderObserver { progress: Some(&inc), cancel: None };
@@ -416,7 +473,12 @@ fn render_progressive(
         if let Some(path) = outputs.variance.as_ref().filter(|_| progressive.samples() >= 2) {
             progressive.variance().save(path).map_err(|e| format!("cannot write `{}`: {e}", path.display()))?;
         }
+        let header = PartialHeader { samples: 0..progressive.samples() as u64, ..state.header.clone() };
+        Partial { header, sums: progressive.accumulator().clone() }
+            .write(&state.path)
+            .map_err(|e| format!("cannot write `{}`: {e}", state.path.display()))?;
     }
+    let _ = std::fs::remove_file(&state.path);
     // Samples skipped by reaching the target still count toward the bar.
     let skipped = (s.spp - progressive.samples()) as u64 * s.width as u64 * s.height as u64;
     progress.inc(skipped);

@@ -95,3 +95,43 @@ fn bad_convergence_options_are_refused_before_rendering() {
     }
     assert!(names(dir.path()).is_empty(), "nothing written");
 }
+
+#[test]
+fn an_interrupted_progressive_render_resumes_to_the_uninterrupted_image() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/spheres_spot_fog.toml");
+    let scene = scene.to_str().unwrap();
+    let args = ["render", scene, "--integrator", "path", "--width", "48", "--height", "36", "--spp", "256"];
+    let whole = airlight(d, &[&args[..], &["--progressive", "-o", "whole.exr", "--quiet"]].concat());
+    assert!(whole.status.success(), "{}", String::from_utf8_lossy(&whole.stderr));
+    assert!(!d.join("whole.partial.exr").exists(), "a finished render leaves no state behind");
+    // Killed once its state holds some samples: mid-render, at no chosen point.
+    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_airlight"))
+        .current_dir(d)
+        .args([&args[..], &["--progressive", "-o", "cut.exr", "--quiet"]].concat())
+        .spawn()
+        .unwrap();
+    let state = d.join("cut.partial.exr");
+    let start = std::time::Instant::now();
+    while !state.exists() && start.elapsed().as_secs() < 60 {
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    }
+    child.kill().unwrap();
+    let status = child.wait().unwrap();
+    assert!(!status.success(), "the render was stopped before it finished");
+    assert!(state.exists());
+    let resumed = airlight(d, &[&args[..], &["--progressive", "--resume", "-o", "cut.exr"]].concat());
+    let stderr = String::from_utf8_lossy(&resumed.stderr);
+    assert!(resumed.status.success(), "{stderr}");
+    assert!(stderr.contains("resuming from"), "{stderr}");
+    assert_eq!(std::fs::read(d.join("cut.exr")).unwrap(), std::fs::read(d.join("whole.exr")).unwrap());
+    assert!(!state.exists());
+    // A state of another render is refused.
+    let other = airlight(d, &[&args[..], &["--progressive", "-o", "x.exr", "--quiet"]].concat());
+    assert!(other.status.success());
+    std::fs::copy(d.join("whole.exr"), d.join("y.partial.exr")).unwrap();
+    let refused = airlight(d, &[&args[..], &["--progressive", "--resume", "-o", "y.exr"]].concat());
+    assert!(!refused.status.success());
+    assert!(String::from_utf8_lossy(&refused.stderr).contains("not an Airlight partial render"));
+}
