@@ -23,6 +23,8 @@ pub struct Lines {
     done: AtomicU64,
     start: Instant,
     interval: Duration,
+    /// Units are pixel samples (print their rate); else they are time.
+    samples: bool,
     /// When the last line was printed, and the message it carries.
     state: Mutex<(Instant, String)>,
 }
@@ -30,6 +32,16 @@ pub struct Lines {
 impl Progress {
     /// Progress over `total` units (pixel samples). Nothing with `quiet`.
     pub fn new(total: u64, quiet: bool) -> Progress {
+        Progress::with_units(total, quiet, true)
+    }
+
+    /// Progress over `total` milliseconds of a time budget (`airlight
+    /// study`): lines give the percentage and the time left, no rate.
+    pub fn timed(total_ms: u64, quiet: bool) -> Progress {
+        Progress::with_units(total_ms, quiet, false)
+    }
+
+    fn with_units(total: u64, quiet: bool, samples: bool) -> Progress {
         if quiet {
             return Progress::Hidden;
         }
@@ -53,6 +65,7 @@ impl Progress {
             done: AtomicU64::new(0),
             start,
             interval: Duration::from_secs_f64(seconds),
+            samples,
             state: Mutex::new((start, String::new())),
         })
     }
@@ -71,6 +84,19 @@ impl Progress {
                     state.0 = Instant::now();
                     lines.print(done, &state.1);
                 }
+            }
+        }
+    }
+
+    /// `done` units done in all (from any thread).
+    pub fn set(&self, done: u64) {
+        match self {
+            Progress::Hidden => {}
+            Progress::Bar(bar) => bar.set_position(done),
+            Progress::Lines(lines) => {
+                lines.done.store(done, Ordering::Relaxed);
+                // Prints a line when one is due.
+                self.inc(0);
             }
         }
     }
@@ -107,10 +133,10 @@ impl Lines {
         let elapsed = self.start.elapsed().as_secs_f64();
         let rate = done as f64 / elapsed.max(1e-9);
         let left = if rate > 0.0 { (self.total.saturating_sub(done)) as f64 / rate } else { f64::INFINITY };
+        let rate = if self.samples { format!(", {} samples/s", si(rate)) } else { String::new() };
         eprintln!(
-            "airlight: {:5.1}% {message}, {} samples/s, {} left",
-            100.0 * done as f64 / self.total as f64,
-            si(rate),
+            "airlight: {:5.1}% {message}{rate}, {} left",
+            100.0 * done.min(self.total) as f64 / self.total as f64,
             duration(left)
         );
     }
