@@ -12,6 +12,7 @@ mod merge;
 mod plot;
 mod progress;
 mod render;
+mod study;
 mod submit;
 mod view;
 
@@ -48,6 +49,10 @@ enum Command {
     /// array, then a merge job.
     #[command(subcommand)]
     Submit(Submit),
+    /// Every integrator that supports the scene, at a ladder of settings,
+    /// timed and measured against a path-traced truth: an HTML report with
+    /// an error-versus-time plot, the same table here, and JSON on request.
+    Study(study::StudyArgs),
     /// Compare two EXR images: prints rmse, rel_mse, mae and max.
     Compare {
         image: PathBuf,
@@ -121,6 +126,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Render(args) => render::render(args),
         Command::Merge(args) => merge::merge(args),
+        Command::Study(args) => study::study(args),
         Command::Submit(Submit::Slurm(args)) => submit::slurm(args),
         Command::Info { scene } => info(&scene),
         Command::Compare { image, reference, map } => compare(&image, &reference, map.as_deref()),

@@ -1,0 +1,170 @@
+//! The ladder a study climbs: every integrator the user asked for, at a few
+//! settings around the scene's own (raymarch steps, analytic light steps
+//! and shadows, lights' attenuation models), each rendered progressively
+//! at 1, 2, 4, … samples per pixel.
+
+use super::data::{NotRun, Transport};
+use airlight::integrator::{IntegratorDesc, IntegratorKind, MAX_LIGHT_STEPS, MAX_STEPS};
+use airlight::light::{AttenuationModel, Light};
+use airlight::scene::Scene;
+
+/// One curve of the study: an integrator at one setting.
+#[derive(Clone, Debug)]
+pub struct SeriesPlan {
+    /// Safe in file names: `raymarch_steps25`.
+    pub id: String,
+    pub label: String,
+    pub kind: IntegratorKind,
+    pub setting: String,
+    pub desc: IntegratorDesc,
+    /// Every point, spot and sphere light switched to this falloff.
+    pub attenuation: Option<AttenuationModel>,
+    pub transport: Transport,
+}
+
+pub const ATTENUATION_MODELS: [(AttenuationModel, &str); 6] = [
+    (AttenuationModel::Physical, "physical"),
+    (AttenuationModel::Sphere, "sphere"),
+    (AttenuationModel::Cutoff, "cutoff"),
+    (AttenuationModel::WindowTan, "window_tan"),
+    (AttenuationModel::WindowRational, "window_rational"),
+    (AttenuationModel::WindowUe4, "window_ue4"),
+];
+
+/// Which transport an integrator computes: single-scattering methods are
+/// measured against path at max_depth 1, the others against the scene's.
+pub fn transport(kind: IntegratorKind, desc: &IntegratorDesc) -> Transport {
+    match kind {
+        IntegratorKind::Direct | IntegratorKind::Raymarch | IntegratorKind::Analytic | IntegratorKind::Stochastic => {
+            Transport::Single
+        }
+        IntegratorKind::Path if desc.path.max_depth == 1 => Transport::Single,
+        IntegratorKind::Path | IntegratorKind::Radiosity => Transport::Full,
+    }
+}
+
+/// A quarter, the same and four times `v`, within [1, max], without repeats.
+fn around(v: u32, max: u32) -> Vec<u32> {
+    let mut out: Vec<u32> = [v / 4, v, v.saturating_mul(4)].into_iter().map(|x| x.clamp(1, max)).collect();
+    out.dedup();
+    out
+}
+
+/// The series to run for `kinds`, in order (the path tracers first: the
+/// others' speed ratios are measured against them), and the variants that
+/// cannot be made, with the reason.
+pub fn ladder(scene: &Scene, base: &IntegratorDesc, kinds: &[IntegratorKind]) -> (Vec<SeriesPlan>, Vec<NotRun>) {
+    let mut plans = Vec::new();
+    let mut refused = Vec::new();
+    let mut push = |kind: IntegratorKind, id: String, setting: String, desc: IntegratorDesc| {
+        let label = if setting.is_empty() { kind.name().to_string() } else { format!("{kind}, {setting}") };
+        let transport = transport(kind, &desc);
+        plans.push(SeriesPlan { id, label, kind, setting, desc, attenuation: None, transport });
+    };
+    let medium = scene.medium().is_some();
+    for kind in [
+        IntegratorKind::Path,
+        IntegratorKind::Direct,
+        IntegratorKind::Raymarch,
+        IntegratorKind::Analytic,
+        IntegratorKind::Stochastic,
+        IntegratorKind::Radiosity,
+    ] {
+        if !kinds.contains(&kind) {
+            continue;
+        }
+        let desc = base.with_kind(kind);
+        match kind {
+            IntegratorKind::Path => {
+                let depth = desc.path.max_depth;
+                push(kind, "path".into(), format!("max_depth {depth}"), desc);
+                if depth > 1 {
+                    let mut single = desc;
+                    single.path.max_depth = 1;
+                    push(kind, "path_depth1".into(), "max_depth 1".into(), single);
+                }
+            }
+            IntegratorKind::Raymarch => {
+                for steps in around(desc.raymarch.steps, MAX_STEPS) {
+                    let mut d = desc;
+                    d.raymarch.steps = steps;
+                    push(kind, format!("raymarch_steps{steps}"), format!("steps {steps}"), d);
+                }
+            }
+            IntegratorKind::Analytic => {
+                // Light steps only matter for line and quad lights in a medium.
+                let area = scene.lights().iter().any(|l| matches!(l, Light::Line { .. } | Light::Quad { .. }));
+                let own = desc.analytic.light_steps;
+                let steps = if medium && area { around(own, MAX_LIGHT_STEPS) } else { vec![own] };
+                let shadows = desc.analytic.shadows;
+                let mut variants: Vec<(bool, u32)> = steps.into_iter().map(|s| (shadows, s)).collect();
+                if medium {
+                    variants.push((!shadows, own));
+                }
+                for (shadows, light_steps) in variants {
+                    let mut d = desc;
+                    d.analytic.shadows = shadows;
+                    d.analytic.light_steps = light_steps;
+                    let s = if shadows { "shadows, " } else { "" };
+                    let id = format!("analytic_{}ls{light_steps}", if shadows { "shadows_" } else { "" });
+                    push(kind, id, format!("{s}light_steps {light_steps}"), d);
+                }
+            }
+            _ => push(kind, kind.name().into(), String::new(), desc),
+        }
+    }
+    if kinds.contains(&IntegratorKind::Raymarch) {
+        attenuation_variants(scene, base, &mut plans, &mut refused);
+    }
+    (plans, refused)
+}
+
+/// Raymarch (at the scene's steps) with every light that has a falloff
+/// switched to each other model the lights accept.
+fn attenuation_variants(scene: &Scene, base: &IntegratorDesc, plans: &mut Vec<SeriesPlan>, refused: &mut Vec<NotRun>) {
+    let lights: Vec<(&Light, _)> = scene.lights().iter().filter_map(|l| Some((l, l.attenuation()?))).collect();
+    if lights.is_empty() {
+        return;
+    }
+    let desc = base.with_kind(IntegratorKind::Raymarch);
+    let steps = desc.raymarch.steps;
+    for (model, name) in ATTENUATION_MODELS {
+        if lights.iter().all(|(_, a)| a.model == model) {
+            continue; // the scene's own
+        }
+        let label = format!("raymarch, steps {steps}, attenuation {name}");
+        let reason = if model == AttenuationModel::Sphere
+            && lights.iter().all(|(l, a)| a.model == AttenuationModel::Physical && !matches!(l, Light::Sphere { .. }))
+        {
+            // attenuation.rs: for a point or spot light both give 1/D².
+            Some("the same law as physical for point and spot lights (1/d² from the centre)".to_string())
+        } else {
+            lights.iter().find_map(|(_, a)| a.with_model(model).err())
+        };
+        match reason {
+            Some(reason) => refused.push(NotRun { label, reason }),
+            None => plans.push(SeriesPlan {
+                id: format!("raymarch_steps{steps}_{name}"),
+                label,
+                kind: IntegratorKind::Raymarch,
+                setting: format!("steps {steps}, attenuation {name}"),
+                desc,
+                attenuation: Some(model),
+                transport: Transport::Single,
+            }),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn settings_spread_around_the_scenes_own() {
+        assert_eq!(around(64, MAX_STEPS), [16, 64, 256]);
+        assert_eq!(around(2, MAX_STEPS), [1, 2, 8]);
+        assert_eq!(around(1, 1), [1]);
+        assert_eq!(around(4096, 4096), [1024, 4096]);
+    }
+}
