@@ -277,7 +277,8 @@ at that spp gives, and its time is what that render would take.</li>\
 path tracer of the same transport (its series in this table) needs to reach e, interpolated linearly in log–log \
 between its rows, over the best error it had reached by each time; beyond its first or last row, extrapolated as \
 error ∝ time^−½ (marked ~). Above 1 the method is faster than path tracing to the same error.</li>\
-<li><b>Time budget</b>: the truths may take half of it; what is left is shared evenly by the series still to run, \
+<li><b>Time budget</b>: the truths may take half of it (single scattering first, then full transport with \
+what is left of that half); what is left is shared evenly by the series still to run, \
 each taking over what earlier ones left. A series stops before a pass that would not fit in its share (a pass costs \
 about as much as all before it); its first pass always runs. No pass runs past the budget's end.</li>\
 <li>A series whose first image is the same, bit for bit, as an earlier one's is not continued (listed above).</li>\

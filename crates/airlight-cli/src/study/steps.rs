@@ -22,16 +22,18 @@ pub fn truths(
     study: &mut Study,
 ) -> Result<Vec<(Transport, Image)>, String> {
     let depth = desc.path.max_depth;
-    let mut wanted = vec![(Transport::Full, depth, "truth")];
+    // Single scattering first: it is the cheaper, and full transport, the
+    // one that matters most, then has what it left of the truths' half.
+    let mut wanted = vec![(Transport::Full, depth, "truth", TRUTH_SEEDS[0])];
     if depth > 1 {
-        wanted.push((Transport::Single, 1, "truth_single"));
+        wanted.insert(0, (Transport::Single, 1, "truth_single", TRUTH_SEEDS[1]));
     }
     let base_seed = scene.settings().seed;
     let share = ctx.deadline.duration_since(ctx.start).as_secs_f64() / 2.0;
     let mut spent = 0.0;
     let mut images = Vec::new();
-    for (i, &(transport, max_depth, name)) in wanted.iter().enumerate() {
-        let seed = base_seed.wrapping_add(TRUTH_SEEDS[i]);
+    for (i, &(transport, max_depth, name, offset)) in wanted.iter().enumerate() {
+        let seed = base_seed.wrapping_add(offset);
         scene.settings_mut().seed = seed;
         let mut d = desc.with_kind(IntegratorKind::Path);
         d.path.max_depth = max_depth;
@@ -100,6 +102,9 @@ pub fn truths(
         }
     }
     scene.settings_mut().seed = base_seed;
+    // Full transport first: the truth of the scene, whatever else there is.
+    study.truths.sort_by_key(|t| t.transport != Transport::Full);
+    images.sort_by_key(|(t, _)| *t != Transport::Full);
     let full = &images[0].1;
     let mean = full.mean();
     study.error_map_scale = ((mean.x + mean.y + mean.z) as f64 / 3.0).max(1e-12);
