@@ -98,6 +98,9 @@ pub struct Row {
     pub speed_ratio: Option<f64>,
     /// The reference's time came from beyond its measured rungs.
     pub ratio_extrapolated: bool,
+    /// The error is below twice the truth's estimated error: much of it
+    /// may be the truth's own noise.
+    pub near_truth_noise: bool,
 }
 
 /// The figures `airlight compare` prints.

@@ -135,7 +135,7 @@ impl Context<'_> {
     fn report(&self, study: &mut Study) -> Result<(), String> {
         study.elapsed_seconds = self.start.elapsed().as_secs_f64();
         study.load_average_now = data::load_average();
-        table::fill_ratios(study);
+        table::fill_derived(study);
         report::write(self.dir, study, self.json)
     }
 

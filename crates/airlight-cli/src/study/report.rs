@@ -171,11 +171,12 @@ fn results(h: &mut String, study: &Study) {
             };
             let _ = write!(
                 h,
-                "<tr{class} data-exr=\"{}\"><td>{label}</td><td>{}</td><td>{}</td><td class=\"rel\">{}</td>",
+                "<tr{class} data-exr=\"{}\"><td>{label}</td><td>{}</td><td>{}</td><td class=\"rel\">{}{}</td>",
                 esc(&row.exr),
                 row.spp,
                 seconds(row.seconds),
-                figure(row.error.rel_rmse)
+                figure(row.error.rel_rmse),
+                if row.near_truth_noise { "<sup>*</sup>" } else { "" }
             );
             if single {
                 let full = row.error_full.map_or(String::new(), |e| figure(e.rel_rmse));
@@ -185,6 +186,12 @@ fn results(h: &mut String, study: &Study) {
         }
     }
     h.push_str("</table>\n");
+    if study.series.iter().flat_map(|s| &s.rows).any(|r| r.near_truth_noise) {
+        h.push_str(
+            "<p class=\"note\">* below twice the truth's estimated error: much of it may be the truth's \
+                    own noise, and the speed ratio there is not to be trusted.</p>\n",
+        );
+    }
 }
 
 fn truths(h: &mut String, study: &Study) {

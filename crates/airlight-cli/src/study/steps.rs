@@ -278,6 +278,7 @@ fn series(
             error_full: full.map(|f| errors(&image, f)).transpose()?,
             speed_ratio: None,
             ratio_extrapolated: false,
+            near_truth_noise: false,
         };
         ctx.progress.set_message(format!("{}: {} spp, relative RMSE {:.4}", plan.label, row.spp, row.error.rel_rmse));
         study.series.last_mut().expect("pushed above").rows.push(row);

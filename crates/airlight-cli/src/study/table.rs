@@ -32,8 +32,10 @@ pub fn reference_id(study: &Study, series: &Series) -> &'static str {
     if series.transport == Transport::Single && study.has_single_truth() { "path_depth1" } else { "path" }
 }
 
-/// Fills every row's speed ratio from the reference's rungs as they stand.
-pub fn fill_ratios(study: &mut Study) {
+/// Fills in what every row's figures imply as the study stands: its speed
+/// ratio from the reference's rungs, and whether its error is close to the
+/// truth's own.
+pub fn fill_derived(study: &mut Study) {
     let references: Vec<(String, Vec<(f64, f64)>)> = study
         .series
         .iter()
@@ -43,7 +45,9 @@ pub fn fill_ratios(study: &mut Study) {
     for i in 0..study.series.len() {
         let id = reference_id(study, &study.series[i]);
         let reference = references.iter().find(|(r, _)| r == id).map(|(_, points)| points.as_slice());
+        let noise = study.truth_for(study.series[i].transport).map_or(0.0, |t| t.estimated_error);
         for row in &mut study.series[i].rows {
+            row.near_truth_noise = row.error.rel_rmse < 2.0 * noise;
             let ratio = reference.and_then(|points| speed_ratio(points, row.seconds, row.error.rel_rmse));
             row.speed_ratio = ratio.map(|r| r.0);
             row.ratio_extrapolated = ratio.is_some_and(|r| r.1);
@@ -111,7 +115,7 @@ pub fn terminal(study: &Study) -> String {
                 if i == 0 { s.label.clone() } else { String::new() },
                 row.spp.to_string(),
                 seconds(row.seconds),
-                figure(row.error.rel_rmse),
+                format!("{}{}", figure(row.error.rel_rmse), if row.near_truth_noise { "*" } else { "" }),
             ];
             if single {
                 line.push(row.error_full.map_or("".into(), |e| figure(e.rel_rmse)));
@@ -132,6 +136,9 @@ pub fn terminal(study: &Study) -> String {
             .collect();
         out.push_str(cells.join("  ").trim_end());
         out.push('\n');
+    }
+    if study.series.iter().flat_map(|s| &s.rows).any(|r| r.near_truth_noise) {
+        out.push_str("* below twice the truth's estimated error: much of it may be the truth's own noise\n");
     }
     out
 }
