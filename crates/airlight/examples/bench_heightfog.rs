@@ -38,7 +38,8 @@ fn progressive(scene: &Scene, integrator: &dyn Integrator, mut after: impl FnMut
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let path = args.first().map_or("scenes/heightfog_point.toml", |s| s.as_str());
-    let number = |i: usize, default: u32| args.get(i).map_or(default, |s| s.parse().expect("SCENE PATH_SPP DEPTH8_SPP"));
+    let number =
+        |i: usize, default: u32| args.get(i).map_or(default, |s| s.parse().expect("SCENE PATH_SPP DEPTH8_SPP"));
     let (path_spp, depth8_spp) = (number(1, 256), number(2, 256));
     let mut scene = airlight::scene::load(path.as_ref()).unwrap_or_else(|e| panic!("{e}"));
     let pixels = (scene.settings.width * scene.settings.height) as f64;
@@ -47,7 +48,8 @@ fn main() {
 
     scene.settings.spp = 16;
     let t = Instant::now();
-    let marched = one.install(|| render_with(&scene, &Raymarch { steps: 2048, jitter: false }, &RenderObserver::none()));
+    let marched =
+        one.install(|| render_with(&scene, &Raymarch { steps: 2048, jitter: false }, &RenderObserver::none()));
     let march_secs = t.elapsed().as_secs_f64();
     println!(
         "raymarch, 2048 steps, jitter off, 16 spp: {march_secs:.2} s, {:.0} samples/s",
