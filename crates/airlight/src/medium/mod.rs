@@ -72,6 +72,13 @@ impl Medium {
         })
     }
 
+    /// Whether the density along every line has the closed form of
+    /// [`Medium::profile`], so that free flights can be drawn and
+    /// transmittance taken exactly.
+    pub fn has_closed_form(&self) -> bool {
+        self.profile(Vec3::ZERO, Vec3::Y).is_some()
+    }
+
     /// ∫ density over the segment o + t·d, t in [t0, t1], d unit; t1 may be
     /// infinite. In closed form for the height fog: with y(t) = o.y + t·d.y
     /// and a = falloff·d.y,

@@ -9,9 +9,10 @@
 //!
 //! and the optical depth in a channel is τ(t) = σt·X(t). A free flight in a
 //! medium whose collision rate is σt·ρ(t) ends where τ reaches an
-//! exponential variate E (Pharr, Jakob and Humphreys, "Physically Based
-//! Rendering", 4th ed., 2023, sec. 11.2.1: inverting the optical depth),
-//! so t = X⁻¹(E/σt), with
+//! exponential variate E, since P(no collision before t) = e^{−τ(t)}
+//! ("closed-form tracking": Novák, Georgiev, Hanika and Jarosz, "Monte
+//! Carlo Methods for Volumetric Light Transport Simulation", Computer
+//! Graphics Forum 2018), so t = X⁻¹(E/σt), with
 //!
 //!   X⁻¹(x) = −ln(1 − a x/ρ0) / a,
 //!

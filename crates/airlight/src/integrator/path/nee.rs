@@ -122,7 +122,7 @@ pub(super) fn equiangular_light(
 /// Whether equiangular sampling applies to a medium: one whose free-flight
 /// densities are closed form (homogeneous or height fog), and scattering.
 pub(super) fn equiangular_applies(medium: &Medium) -> bool {
-    medium.profile(Vec3::ZERO, Vec3::Y).is_some() && medium.sigma_s.max_element() > 0.0
+    medium.has_closed_form() && medium.sigma_s.max_element() > 0.0
 }
 
 /// The medium a path travels through (if any) and whether its
@@ -178,7 +178,7 @@ pub(super) fn direct_light(
         }
         let (mut t_ray, mut r_l, mut r_u) = (Rgb::ONE, Rgb::ONE, Rgb::ONE);
         if let Some(m) = medium {
-            if fog.closed_form && m.profile(origin, ls.wi).is_some() {
+            if fog.closed_form && m.has_closed_form() {
                 // Exact transmittance. The MIS ratios get T/T[hero], the
                 // expected factor of ratio tracking, so that both
                 // strategies' pdfs carry the transmittance per channel as
