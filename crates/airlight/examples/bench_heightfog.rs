@@ -1,7 +1,7 @@
 //! The path tracer in exponential height fog (issue 15), on one thread.
 //!
-//! `cargo run --release -p airlight --example bench_heightfog [-- SCENE PATH_SPP DEPTH8_SPP]`
-//! (defaults scenes/heightfog_point.toml, 256, 256)
+//! `cargo run --release -p airlight --example bench_heightfog [-- SCENE PATH_SPP DEPTH8_SPP [REF.exr [REF_SPP]]]`
+//! (defaults scenes/heightfog_point.toml, 256, 256, no reference, 65536)
 //!
 //! 1. `raymarch`, 2048 steps, midpoints (jitter off), 16 spp: seconds and
 //!    samples per second. The scene's filter is `point`, so both
@@ -15,9 +15,13 @@
 //!    DEPTH8_SPP: after each pass the seconds so far and the estimated
 //!    relative error. Time to 1% is read off, or, when DEPTH8_SPP stops
 //!    short of it, extrapolated from the last pass as t·(e/0.01)² (error
-//!    falls as 1/√spp).
+//!    falls as 1/√spp). With REF.exr, each pass also shows its relative
+//!    RMSE against that reference (read if the file exists, else rendered
+//!    at REF_SPP spp with max_depth 8, another seed, all threads, untimed,
+//!    and written there): a check of the estimate, which reads low while
+//!    rare bright samples are missing.
 
-use airlight::film::compare;
+use airlight::film::{Image, compare};
 use airlight::integrator::{Integrator, PathTracer, Raymarch};
 use airlight::render::{Progressive, RenderObserver, render_with};
 use airlight::scene::Scene;
@@ -40,7 +44,7 @@ fn main() {
     let path = args.first().map_or("scenes/heightfog_point.toml", |s| s.as_str());
     let number =
         |i: usize, default: u32| args.get(i).map_or(default, |s| s.parse().expect("SCENE PATH_SPP DEPTH8_SPP"));
-    let (path_spp, depth8_spp) = (number(1, 256), number(2, 256));
+    let (path_spp, depth8_spp, ref_spp) = (number(1, 256), number(2, 256), number(4, 65536));
     let mut scene = airlight::scene::load(path.as_ref()).unwrap_or_else(|e| panic!("{e}"));
     let pixels = (scene.settings.width * scene.settings.height) as f64;
     let one = rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap();
@@ -70,14 +74,27 @@ fn main() {
         error / noise
     );
 
+    let reference = args.get(3).map(|file| {
+        let file = std::path::Path::new(file);
+        if let Ok(image) = Image::read_exr(file) {
+            return image;
+        }
+        let (spp, seed) = (scene.settings.spp, scene.settings.seed);
+        (scene.settings.spp, scene.settings.seed) = (ref_spp, seed.wrapping_add(1));
+        let image = render_with(&scene, &PathTracer::new(8), &RenderObserver::none());
+        (scene.settings.spp, scene.settings.seed) = (spp, seed);
+        image.write(file, 0.0, airlight::scene::Tonemap::Clamp).expect("cannot write the reference");
+        image
+    });
     scene.settings.spp = depth8_spp;
-    println!("path, max_depth 8: spp, seconds, estimated relative error");
+    println!("path, max_depth 8: spp, seconds, estimated relative error[, relative RMSE against the reference]");
     let mut last = (0.0, f64::INFINITY);
     let mut reached = None;
     one.install(|| {
         progressive(&scene, &PathTracer::new(8), |state, secs| {
             let e = state.estimated_relative_error();
-            println!("  {} {secs:.2} {e:.4}", state.samples());
+            let measured = reference.as_ref().map(|r| format!(" {:.4}", compare(&state.image(), r).unwrap().rel_rmse));
+            println!("  {} {secs:.2} {e:.4}{}", state.samples(), measured.unwrap_or_default());
             last = (secs, e);
             if e <= 0.01 && reached.is_none() {
                 reached = Some((state.samples(), secs));
