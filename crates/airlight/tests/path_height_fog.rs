@@ -147,3 +147,29 @@ fn single_scattering_in_height_fog_agrees_with_marching_within_noise() {
         assert!(lo < 0.3 * hi, "{name}: no visible glow: {lo} vs {hi}");
     }
 }
+
+#[test]
+fn extreme_height_fog_gives_finite_images() {
+    // Far below the base (ρ = e^{160}, beyond f32), far above it looking
+    // down, a level fog (falloff 0), a steep one, and huge coefficients:
+    // every pixel finite and non-negative, with multiple scattering. (The
+    // overflows themselves are tested on the density profile, medium
+    // tests; this is the integrator's smoke test on such input.)
+    let camera_at = |y: f32| Camera::look_at(vec3(0.0, y, -6.0), vec3(0.0, y - 2.0, 0.0), Vec3::Y, 60.0);
+    let grey = |sa: f32, ss: f32, falloff: f32| Medium::height(Rgb::splat(sa), Rgb::splat(ss), 0.2, -1.0, falloff);
+    let cases = [
+        (grey(0.05, 0.3, 0.8), camera_at(-201.0)),
+        (grey(0.05, 0.3, 0.8), camera_at(400.0)),
+        (grey(0.05, 0.3, 0.0), camera_at(1.0)),
+        (grey(0.05, 0.3, 20.0), camera_at(0.0)),
+        (Medium::height(Rgb::new(0.0, 1e6, 0.1), Rgb::new(1e6, 0.0, 0.0), 0.9, -1.0, 0.8), camera_at(1.0)),
+    ];
+    for (medium, camera) in cases {
+        let mut scene = open_fog(medium, Light::point(vec3(0.0, 0.5, 0.0), Rgb::splat(10.0)), camera, 16);
+        (scene.settings.width, scene.settings.height) = (8, 8);
+        let image = render_with(&scene, &PathTracer::new(8), &RenderObserver::none());
+        for p in &image.pixels {
+            assert!(p.is_finite() && p.min_element() >= 0.0, "{medium:?}: pixel {p}");
+        }
+    }
+}
