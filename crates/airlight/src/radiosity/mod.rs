@@ -314,6 +314,34 @@ impl Radiosity {
         self.lookup.interpolate(&self.patches, p, n, |i| self.indirect[i])
     }
 
+    /// [`Radiosity::irradiance_at`] from the patches that `p` sees in
+    /// `geometry`: a point near a wall does not take the light of patches
+    /// on its other side (a floor that runs under a wall into the sun). It
+    /// costs a shadow ray per nearby patch; the viewer's preview does
+    /// without.
+    pub fn irradiance_seen_at(&self, p: Vec3, n: Vec3, geometry: &crate::geometry::Geometry) -> Option<Rgb> {
+        // The path from p to a patch's centre runs just above the surface
+        // (lifted by ε at both ends), bent at its middle over a curved one: a
+        // ball's chord dips below its surface by d·θ/8 (θ the angle between
+        // the two normals), so the middle is lifted by twice that. A wall
+        // between them, or the far face of a thin slab, still stops it.
+        let epsilon = 1e-3 * self.lookup.radius();
+        let clear = |a: Vec3, b: Vec3| {
+            let to = b - a;
+            let length = to.length();
+            length <= 0.0 || !geometry.occluded(a, to / length, length * (1.0 - 1e-4))
+        };
+        let sees = |i: usize| {
+            let patch = &self.patches[i];
+            let (from, to) = (p + n * epsilon, patch.center + patch.normal * epsilon);
+            let angle = n.dot(patch.normal).clamp(-1.0, 1.0).acos();
+            let up = (n + patch.normal).normalize_or(n);
+            let middle = 0.5 * (from + to) + up * (0.25 * angle * from.distance(to) + epsilon);
+            clear(from, middle) && clear(middle, to)
+        };
+        self.lookup.interpolate_where(&self.patches, p, n, sees, |i| self.indirect[i])
+    }
+
     pub fn params(&self) -> CompileParams {
         self.params
     }
