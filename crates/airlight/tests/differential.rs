@@ -33,7 +33,7 @@ use airlight::prelude::*;
 use airlight::render::accumulate;
 use airlight::scene::PixelFilter;
 
-const DEFAULT_SCENES: u64 = 120;
+const DEFAULT_SCENES: u64 = 200;
 const SIZE: u32 = 6;
 /// Radiosity's patches: coarse, for speed (rooms of 8 units, objects of 0.2
 /// to 2).
@@ -55,9 +55,6 @@ impl Rng {
     }
     fn point(&mut self, r: f32) -> Vec3 {
         vec3(self.range(-r, r), self.range(-r, r), self.range(-r, r))
-    }
-    fn chance(&mut self, p: f32) -> bool {
-        self.next() < p
     }
     fn pick(&mut self, n: usize) -> usize {
         ((self.next() * n as f32) as usize).min(n - 1)
