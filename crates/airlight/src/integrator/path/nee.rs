@@ -32,6 +32,7 @@ use crate::light::Light;
 use crate::medium::Medium;
 use crate::sampling::{Sampler, keyed2};
 use crate::scene::Scene;
+use crate::scene::light_numbers;
 use glam::Vec3;
 
 /// A ray's stretch [0, length] through a medium with a closed-form
@@ -96,12 +97,11 @@ pub(super) fn equiangular_light(
         let t = equiangular.sample(u.x);
         let pdf = equiangular.pdf(t);
         let p = segment.ray.at(t);
-        let Some(ls) = light.sample(p, keyed2(key, 2 * index as u64 + 1)) else { continue };
-        let phase = medium.phase(wo, ls.wi);
-        if pdf <= 0.0 || !pdf.is_finite() || phase <= 0.0 || ls.weight == Rgb::ZERO {
+        let Some(ls) = scene.sample_light(index, p, light_numbers(keyed2(key, 2 * index as u64 + 1))) else {
             continue;
-        }
-        if !scene.light_visible(p, p, ls.wi, ls.distance) {
+        };
+        let phase = medium.phase(wo, ls.wi);
+        if pdf <= 0.0 || !pdf.is_finite() || phase <= 0.0 || !scene.unoccluded(p, None, &ls) {
             continue;
         }
         let t_light = medium.transmittance(p, ls.wi, 0.0, scene.light_distance(ls.distance));
@@ -157,25 +157,23 @@ pub(super) fn direct_light(
     let key = sampler.next_key();
     let mut total = Rgb::ZERO;
     scene.for_each_light_at(p, |index, light| {
-        let Some(ls) = light.sample(p, keyed2(key, index as u64)) else { return };
-        let (f, scatter_pdf, origin) = match *vertex {
+        let Some(ls) = scene.sample_light(index, p, light_numbers(keyed2(key, index as u64))) else { return };
+        let (f, scatter_pdf, normal) = match *vertex {
             Vertex::Surface { p, n, material } => {
                 let m = scene.material(material);
                 let f = m.brdf(p, n, wo, ls.wi) * ls.wi.dot(n).abs();
-                (f, m.pdf(p, n, wo, ls.wi), offset_origin(p, n, ls.wi))
+                (f, m.pdf(p, n, wo, ls.wi), Some(n))
             }
-            Vertex::Medium { p, .. } => {
+            Vertex::Medium { .. } => {
                 let phase = medium.map_or(0.0, |m| m.phase(wo, ls.wi));
-                (Rgb::splat(phase), phase, p)
+                (Rgb::splat(phase), phase, None)
             }
         };
-        if f == Rgb::ZERO || ls.weight == Rgb::ZERO {
+        if f == Rgb::ZERO || !scene.unoccluded(p, normal, &ls) {
             return;
         }
+        let origin = normal.map_or(p, |n| offset_origin(p, n, ls.wi));
         let distance = scene.light_distance(ls.distance);
-        if !scene.light_visible(p, origin, ls.wi, ls.distance) {
-            return;
-        }
         let (mut t_ray, mut r_l, mut r_u) = (Rgb::ONE, Rgb::ONE, Rgb::ONE);
         if let Some(m) = medium {
             if fog.closed_form && m.has_closed_form() {
