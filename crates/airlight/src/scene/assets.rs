@@ -61,7 +61,7 @@ impl AssetPath {
                 return Ok(found);
             }
         }
-        Err(format!("no file `{name}` in {}", self.describe()))
+        Err(format!("no file `{name}` in {} (more folders: {ASSET_PATH_VAR})", self.describe()))
     }
 
     /// "the scene's folder `d`" or "the scene's folder `d` or the asset folders `a`, `b`".

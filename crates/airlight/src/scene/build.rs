@@ -187,6 +187,10 @@ impl Checker<'_> {
 
     /// A quad's edges: not parallel (in f64), and making a normal in f32.
     pub(super) fn edges(&self, span: Range<usize>, label: &str, u: Vec3, v: Vec3) -> Result<()> {
+        let reach = limits::reach_of(u).max(limits::reach_of(v));
+        if reach > limits::MAX_COORDINATE {
+            return Err(self.err_field(span, "edge_u", limits::too_far(&format!("{label}.edge_u or edge_v"), reach)));
+        }
         let parallel = limits::unit(u).is_none() || limits::unit(v).is_none() || limits::sin_between(u, v) == 0.0;
         if parallel {
             return Err(self.err_field(
@@ -195,15 +199,15 @@ impl Checker<'_> {
                 format!("{label}: edge_u and edge_v must not be parallel or zero"),
             ));
         }
-        let area = u.cross(v).length();
-        if !(area.is_normal() && area.is_finite()) {
+        // The quad's normal and area come from |u × v|² in f32.
+        if !u.cross(v).length_squared().is_normal() {
             let exact = u.as_dvec3().cross(v.as_dvec3()).length();
             return Err(self.err_field(
                 span,
                 "edge_v",
                 format!(
-                    "{label}: the area |edge_u × edge_v| = {exact:e} is out of the range of 32-bit floats; \
-                     it must lie between 1e-37 and 1e38"
+                    "{label}: the area |edge_u × edge_v| = {exact:.3e} is too small for 32-bit floats; \
+                     it must be at least 1.1e-19"
                 ),
             ));
         }
