@@ -2,12 +2,13 @@
 //! error target), or the numbered frames of a light animation.
 
 use crate::load;
+use crate::preflight::Forecast;
 use airlight::SceneFile;
 use airlight::film::Image;
 use airlight::integrator::analytic::LightQuadrature;
-use airlight::integrator::{Integrator, IntegratorKind, Sampling};
+use airlight::integrator::{Integrator, IntegratorKind, MAX_LIGHT_STEPS, MAX_STEPS, Sampling};
 use airlight::render::{Progressive, RenderObserver, frame_time, set_time};
-use airlight::scene::Scene;
+use airlight::scene::{MAX_IMAGE_SIDE, MAX_SPP, Scene};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -48,17 +49,17 @@ pub struct RenderArgs {
     /// Render N frames of the scene's light animation (lights with
     /// keyframes), frame k at time k/(N − 1), each output numbered:
     /// NAME_0000.png, NAME_0001.png, ...
-    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..))]
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=crate::preflight::MAX_FRAMES as i64))]
     frames: Option<u32>,
     /// Samples per pixel.
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=MAX_SPP as i64))]
     spp: Option<u32>,
     /// March samples per ray.
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=MAX_STEPS as i64))]
     steps: Option<u32>,
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=MAX_IMAGE_SIDE as i64))]
     width: Option<u32>,
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=MAX_IMAGE_SIDE as i64))]
     height: Option<u32>,
     #[arg(long)]
     seed: Option<u64>,
@@ -70,7 +71,7 @@ pub struct RenderArgs {
     #[arg(long)]
     shadows: bool,
     /// analytic: points per dimension over line and quad lights.
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=4096))]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=MAX_LIGHT_STEPS as i64))]
     light_steps: Option<u32>,
     /// analytic: gauss (Gauss–Legendre) or uniform (the seed's stepping) over lights.
     #[arg(long, value_parser = parse_light_quadrature)]
@@ -103,11 +104,14 @@ pub fn render(args: RenderArgs) -> Result<(), String> {
     if args.frames.is_some() && !scene.is_animated() {
         return Err("--frames: the scene has no light with keyframes to animate".into());
     }
+    let progressive = args.progressive || args.target_error.is_some() || args.variance.is_some();
+    crate::outputs::check_render(args.scene.as_deref(), scene.files(), &outputs, args.variance.as_deref())?;
+    crate::preflight::render_memory(&scene, progressive)?;
+    crate::preflight::warn_if_dark(&scene, desc.kind != IntegratorKind::Direct);
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(args.threads.unwrap_or(0) as usize)
         .build()
         .map_err(|e| format!("cannot start worker threads: {e}"))?;
-    let progressive = args.progressive || args.target_error.is_some() || args.variance.is_some();
     let frames = args.frames.unwrap_or(1);
     let s = scene.settings();
     let per_frame = s.width as u64 * s.height as u64 * s.spp as u64;
@@ -120,6 +124,7 @@ pub fn render(args: RenderArgs) -> Result<(), String> {
         bar.set_style(style.progress_chars("=> "));
     }
     let start = Instant::now();
+    let forecast = Forecast::new(per_frame * frames as u64, describe(&scene, args.frames));
     // Built once: between frames the integrator only hears that the lights
     // moved (radiosity relights without recompiling).
     let mut integrator = pool.install(|| desc.build(&scene)).map_err(|e| e.to_string())?;
@@ -139,9 +144,17 @@ pub fn render(args: RenderArgs) -> Result<(), String> {
         let frame_label = args.frames.map(|n| format!(" frame {}/{n}", frame + 1)).unwrap_or_default();
         let label = format!("{}{frame_label}", desc.kind);
         let summary = if progressive {
-            render_progressive(&scene, integrator.as_ref(), &pool, &bar, &outputs, args.target_error, &label)?
+            render_progressive(
+                &scene,
+                integrator.as_ref(),
+                &pool,
+                (&bar, &forecast),
+                &outputs,
+                args.target_error,
+                &label,
+            )?
         } else {
-            render_once(&scene, integrator.as_ref(), &pool, &bar, &outputs, &label)?
+            render_once(&scene, integrator.as_ref(), &pool, (&bar, &forecast), &outputs, &label)?
         };
         if !args.quiet && args.frames.is_none() && !summary.is_empty() {
             bar.suspend(|| eprintln!("{summary}"));
@@ -257,13 +270,13 @@ fn render_once(
     scene: &Scene,
     integrator: &dyn Integrator,
     pool: &rayon::ThreadPool,
-    bar: &ProgressBar,
+    (bar, forecast): (&ProgressBar, &Forecast),
     outputs: &FrameOutputs,
     label: &str,
 ) -> Result<String, String> {
     let s = scene.settings();
     bar.set_message(format!("{label} {}×{} {} spp", s.width, s.height, s.spp));
-    let progress = |n: u64| bar.inc(n);
+    let progress = |n: u64| advance(bar, forecast, n);
     let observer = RenderObserver { progress: Some(&progress), cancel: None };
     let image = pool.install(|| airlight::render(scene, integrator, &observer));
     write_images(scene, &image, &outputs.images)?;
@@ -277,7 +290,7 @@ fn render_progressive(
     scene: &Scene,
     integrator: &dyn Integrator,
     pool: &rayon::ThreadPool,
-    bar: &ProgressBar,
+    (bar, forecast): (&ProgressBar, &Forecast),
     outputs: &FrameOutputs,
     target_error: Option<f64>,
     label: &str,
@@ -286,7 +299,7 @@ fn render_progressive(
     let mut progressive = Progressive::new(scene);
     let mut error = f64::INFINITY;
     while !progressive.finished() && !target_error.is_some_and(|target| error < target) {
-        let progress = |n: u64| bar.inc(n);
+        let progress = |n: u64| advance(bar, forecast, n);
         let observer = RenderObserver { progress: Some(&progress), cancel: None };
         pool.install(|| progressive.pass(scene, integrator, &observer));
         error = progressive.estimated_relative_error();
@@ -310,6 +323,21 @@ fn render_progressive(
     bar.inc(skipped);
     Ok(format!("{} spp, estimated relative error {}", progressive.samples(), format_error(error)))
 }
+/// Counts finished samples on the bar and warns if the run looks endless.
+fn advance(bar: &ProgressBar, forecast: &Forecast, samples: u64) {
+    bar.inc(samples);
+    if let Some(warning) = forecast.advance(samples) {
+        bar.suspend(|| eprintln!("{warning}"));
+    }
+}
+
+/// "this render (N frames of W×H at S spp)", for the forecast.
+fn describe(scene: &Scene, frames: Option<u32>) -> String {
+    let s = scene.settings();
+    let frames = frames.map(|n| format!("{n} frames of ")).unwrap_or_default();
+    format!("this render ({frames}{}×{} at {} spp)", s.width, s.height, s.spp)
+}
+
 fn format_error(error: f64) -> String {
     if error.is_finite() { format!("{error:.4}") } else { "unknown (fewer than 2 samples)".into() }
 }
