@@ -203,7 +203,7 @@ fn gi(args: GiArgs) -> Result<(), String> {
             ms(st.link)
         );
         let mut frames = Vec::with_capacity(args.frames as usize);
-        let forecast = preflight::Forecast::new(args.frames as u64, format!("{} frames", args.frames));
+        let forecast = preflight::Forecast::new(args.frames as u64, format!("{} frames", args.frames), false);
         for k in 0..args.frames {
             if let Some(warning) = forecast.advance(1) {
                 eprintln!("{warning}");
@@ -306,7 +306,7 @@ fn attenuation(args: AttenuationArgs) -> Result<(), String> {
     let e0 = positive(args.intensity, "intensity")? / (r * r);
     if !(e0.is_normal() && e0.is_finite()) {
         return Err(format!(
-            "the irradiance at the light's surface, --intensity / --radius² = {:e}, is out of the range of 32-bit \
+            "the irradiance at the light's surface, --intensity / --radius² = {:.3e}, is out of the range of 32-bit \
              floats (about 1e-38 to 3e38)",
             args.intensity as f64 / (r as f64 * r as f64)
         ));
@@ -333,7 +333,7 @@ fn attenuation(args: AttenuationArgs) -> Result<(), String> {
     let finite = curves.iter().map(|(a, ..)| a.range).filter(|d| d.is_finite()).fold(0.0, f32::max);
     if finite <= 0.0 {
         return Err(format!(
-            "no curve reaches zero at a finite distance: I/r² / --cutoff = {:e} overflows 32-bit floats; \
+            "no curve reaches zero at a finite distance: I/r² / --cutoff = {:.3e} overflows 32-bit floats; \
              give a larger --cutoff, or a --range",
             e0 as f64 / cutoff as f64
         ));

@@ -3,6 +3,7 @@
 //! longer than anyone means them to, images with broken pixels.
 
 use airlight::Image;
+use airlight::integrator::Integrator;
 use airlight::scene::Scene;
 use std::sync::Mutex;
 use std::time::{Duration, Instant};
@@ -47,6 +48,33 @@ pub fn finite_pixels(image: &Image, path: &std::path::Path) -> Result<(), String
     ))
 }
 
+/// Samples in [`probe`]: a 4×4 grid of pixels, one sample each.
+const PROBE: u32 = 4;
+
+/// Times one sample of each of 16 pixels spread over the image and, when
+/// the whole run (`frames` frames of every pixel at the scene's spp, on
+/// `threads` threads) would take more than [`Forecast::LONG`] at that
+/// pace, says so: before the first tile, which at millions of samples per
+/// pixel may itself take hours, reports any progress.
+pub fn probe(scene: &Scene, integrator: &dyn Integrator, threads: usize, frames: u32, what: &str) -> Option<String> {
+    let s = scene.settings();
+    let start = Instant::now();
+    for i in 0..PROBE * PROBE {
+        let (x, y) = ((2 * (i % PROBE) + 1) * s.width / (2 * PROBE), (2 * (i / PROBE) + 1) * s.height / (2 * PROBE));
+        airlight::render::pixel_sum(scene, integrator, x, y, 0..1);
+    }
+    let per_sample = start.elapsed().as_secs_f64() / (PROBE * PROBE) as f64;
+    let samples = s.width as f64 * s.height as f64 * s.spp as f64 * frames as f64;
+    let projected = per_sample * samples / threads.max(1) as f64;
+    (projected > Forecast::LONG.as_secs_f64()).then(|| {
+        format!(
+            "warning: by a probe of {} samples, {what} will take about {} on {threads} threads (stop it with Ctrl-C)",
+            PROBE * PROBE,
+            human(projected)
+        )
+    })
+}
+
 /// A run's projected length, from its pace so far: once a few seconds in,
 /// it warns (once) when the whole run would take more than [`Forecast::LONG`].
 pub struct Forecast {
@@ -62,9 +90,10 @@ impl Forecast {
     /// The pace is measured over at least this long before a projection.
     const SETTLE: Duration = Duration::from_secs(2);
 
-    /// A run of `total` units of work (pixel samples, frames), described by `what`.
-    pub fn new(total: u64, what: impl Into<String>) -> Self {
-        Forecast { start: Instant::now(), total, what: what.into(), state: Mutex::new((0, false)) }
+    /// A run of `total` units of work (pixel samples, frames), described
+    /// by `what`; `warned`: the warning was already given (by [`probe`]).
+    pub fn new(total: u64, what: impl Into<String>, warned: bool) -> Self {
+        Forecast { start: Instant::now(), total, what: what.into(), state: Mutex::new((0, warned)) }
     }
 
     /// Counts `done` more units; returns the warning when it is time to give it.
@@ -118,13 +147,16 @@ mod tests {
 
     #[test]
     fn a_run_projected_past_an_hour_is_warned_about_once() {
-        let f = Forecast { start: Instant::now() - Duration::from_secs(10), ..Forecast::new(1_000_000, "this render") };
+        let f = Forecast {
+            start: Instant::now() - Duration::from_secs(10),
+            ..Forecast::new(1_000_000, "this render", false)
+        };
         assert_eq!(
             f.advance(1_000),
             Some("warning: at its pace so far, this render will take about 2.8 hours (stop it with Ctrl-C)".into())
         );
         assert_eq!(f.advance(1_000), None);
-        let quick = Forecast { start: Instant::now() - Duration::from_secs(10), ..Forecast::new(1_000, "that") };
+        let quick = Forecast { start: Instant::now() - Duration::from_secs(10), ..Forecast::new(1_000, "that", false) };
         assert_eq!(quick.advance(500), None);
         assert_eq!(human(3.0 * 86400.0), "3.0 days");
         assert_eq!(human(42.0), "42 s");

@@ -124,10 +124,15 @@ pub fn render(args: RenderArgs) -> Result<(), String> {
         bar.set_style(style.progress_chars("=> "));
     }
     let start = Instant::now();
-    let forecast = Forecast::new(per_frame * frames as u64, describe(&scene, args.frames));
     // Built once: between frames the integrator only hears that the lights
     // moved (radiosity relights without recompiling).
     let mut integrator = pool.install(|| desc.build(&scene)).map_err(|e| e.to_string())?;
+    let what = describe(&scene, args.frames);
+    let probe = crate::preflight::probe(&scene, integrator.as_ref(), pool.current_num_threads(), frames, &what);
+    if let Some(warning) = &probe {
+        bar.suspend(|| eprintln!("{warning}"));
+    }
+    let forecast = Forecast::new(per_frame * frames as u64, what, probe.is_some());
     let mut written = Vec::new();
     for frame in 0..frames {
         let outputs = match args.frames {
