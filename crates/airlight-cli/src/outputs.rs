@@ -81,19 +81,47 @@ pub fn check(outputs: &[Output], inputs: &[&Path]) -> Result<(), String> {
     Ok(())
 }
 
-/// The checks of `airlight render`: its images (`-o`, numbered alike when
-/// there are frames) and variance against each other, the scene file as
-/// named and every file the scene was read from.
+/// The checks of `airlight render`: its images (`-o`) and variance
+/// against each other, the scene file as named and every file the scene
+/// was read from. With `frames`, the outputs are numbered (`NAME_0007.png`):
+/// an input that one of those names would be is refused too.
 pub fn check_render(
     scene: Option<&Path>,
     files: &[PathBuf],
     images: &[PathBuf],
     variance: Option<&Path>,
+    frames: Option<u32>,
 ) -> Result<(), String> {
-    let mut outputs: Vec<Output> = images.iter().map(|p| Output { option: "-o", path: p }).collect();
-    outputs.extend(variance.map(|p| Output { option: "--variance", path: p }));
     let inputs: Vec<&Path> = scene.into_iter().chain(files.iter().map(PathBuf::as_path)).collect();
+    let given = images.iter().map(|p| ("-o", p.as_path())).chain(variance.map(|p| ("--variance", p)));
+    let mut numbered = Vec::new();
+    let mut outputs = Vec::new();
+    for (option, path) in given {
+        outputs.push(Output { option, path });
+        if let Some(n) = frames {
+            numbered.extend(inputs.iter().filter_map(|input| frame_name(path, input, n)).map(|p| (option, p)));
+        }
+    }
+    outputs.extend(numbered.iter().map(|(option, path)| Output { option, path }));
     check(&outputs, &inputs)
+}
+
+/// `base` numbered for the frame that `input`'s name gives, when that frame
+/// is one of `frames` (so the numbered output and `input` share a name).
+fn frame_name(base: &Path, input: &Path, frames: u32) -> Option<PathBuf> {
+    let stem = base.file_stem()?.to_str()?;
+    let name = input.file_name()?.to_str()?;
+    let rest = name.strip_prefix(stem)?.strip_prefix('_')?;
+    let digits = match base.extension() {
+        Some(ext) => rest.strip_suffix(ext.to_str()?)?.strip_suffix('.')?,
+        None => rest,
+    };
+    let frame: u32 = digits.parse().ok().filter(|&k| k < frames && format!("{k:04}") == digits)?;
+    let numbered = match base.extension() {
+        Some(ext) => format!("{stem}_{frame:04}.{}", ext.to_str()?),
+        None => format!("{stem}_{frame:04}"),
+    };
+    Some(base.with_file_name(numbered))
 }
 
 /// Checks a folder a command will create files in (creating it, as the
@@ -131,5 +159,12 @@ mod tests {
         assert!(e.contains("missing"), "{e}");
         let e = check(&[out("-o", &d.join("sub"))], &[]).unwrap_err();
         assert!(e.contains("it is a folder"), "{e}");
+        // Frame 7 of `-o scene.exr --frames 8` would be scene_0007.exr.
+        std::fs::write(d.join("scene_0007.exr"), "").unwrap();
+        let numbered = d.join("scene_0007.exr");
+        let base = [d.join("scene.exr")];
+        assert!(check_render(None, std::slice::from_ref(&numbered), &base, None, Some(8)).is_err());
+        assert!(check_render(None, std::slice::from_ref(&numbered), &base, None, Some(7)).is_ok());
+        assert!(check_render(None, std::slice::from_ref(&numbered), &base, None, None).is_ok());
     }
 }

@@ -105,7 +105,8 @@ pub fn render(args: RenderArgs) -> Result<(), String> {
         return Err("--frames: the scene has no light with keyframes to animate".into());
     }
     let progressive = args.progressive || args.target_error.is_some() || args.variance.is_some();
-    crate::outputs::check_render(args.scene.as_deref(), scene.files(), &outputs, args.variance.as_deref())?;
+    let (files, variance) = (scene.files(), args.variance.as_deref());
+    crate::outputs::check_render(args.scene.as_deref(), files, &outputs, variance, args.frames)?;
     crate::preflight::render_memory(&scene, progressive)?;
     crate::preflight::warn_if_dark(&scene, desc.kind != IntegratorKind::Direct);
     let pool = rayon::ThreadPoolBuilder::new()

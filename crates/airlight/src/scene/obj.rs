@@ -59,9 +59,15 @@ pub fn count(bytes: &[u8]) -> (u64, u64) {
 /// Reads `bytes` with room for `vertices` and `triangles` (from [`count`]).
 pub fn parse(bytes: &[u8], vertices: u64, triangles: u64) -> Result<Obj, ObjError> {
     let mut obj = Obj::default();
-    let too_many = |what: &str| ObjError { line: 0, message: format!("too many {what} for memory") };
-    obj.positions.try_reserve_exact(vertices as usize).map_err(|_| too_many("vertices"))?;
-    obj.triangles.try_reserve_exact(triangles as usize).map_err(|_| too_many("triangles"))?;
+    let refused = |count: u64, what: &str, size: u64| ObjError {
+        line: 0,
+        message: format!(
+            "{count} {what} need {}, which could not be allocated",
+            crate::memory::format_bytes(count.saturating_mul(size))
+        ),
+    };
+    obj.positions.try_reserve_exact(vertices as usize).map_err(|_| refused(vertices, "vertices", 12))?;
+    obj.triangles.try_reserve_exact(triangles as usize).map_err(|_| refused(triangles, "triangles", 12))?;
     // The largest index met, and where: checked once every vertex is known.
     let mut highest: Option<(u32, usize)> = None;
     let mut face: Vec<u32> = Vec::new();
