@@ -12,6 +12,10 @@ use std::time::{Duration, Instant};
 /// --headless --frames`): 2²⁰, about 10 hours of 30 fps video.
 pub const MAX_FRAMES: u32 = 1 << 20;
 
+/// Most worker threads (`--threads`): spawning tens of thousands takes
+/// minutes before any work starts.
+pub const MAX_THREADS: u32 = 4096;
+
 /// Refuses a render whose image and sums would not fit in memory.
 pub fn render_memory(scene: &Scene, progressive: bool) -> Result<(), String> {
     let s = scene.settings();

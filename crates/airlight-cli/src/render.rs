@@ -77,7 +77,7 @@ pub struct RenderArgs {
     #[arg(long, value_parser = parse_light_quadrature)]
     light_quadrature: Option<LightQuadrature>,
     /// Worker threads (default: all cores). The image does not depend on it.
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=crate::preflight::MAX_THREADS as i64))]
     threads: Option<u32>,
     /// No progress bar or summary.
     #[arg(long, short)]

@@ -69,7 +69,7 @@ pub struct ViewArgs {
     #[arg(long)]
     no_dynamic_resolution: bool,
     /// Worker threads (default: all cores).
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=crate::preflight::MAX_THREADS as i64))]
     threads: Option<u32>,
 }
 
