@@ -172,6 +172,20 @@ mod tests {
         assert_eq!(fs::read(&target).unwrap(), b"keep me");
     }
 
+    #[cfg(target_os = "linux")]
+    #[test]
+    fn on_linux_the_file_has_no_name_until_it_is_complete() {
+        let dir = tempfile::tempdir().unwrap();
+        let Some(mut file) = anonymous(dir.path()) else {
+            eprintln!("this file system has no O_TMPFILE: the named fallback is used");
+            return;
+        };
+        write_synced(&mut file, b"whole").unwrap();
+        assert!(names(dir.path()).is_empty(), "nothing to see, or to leave behind, while writing");
+        link(&file, &dir.path().join("done")).unwrap();
+        assert_eq!(fs::read(dir.path().join("done")).unwrap(), b"whole");
+    }
+
     #[test]
     fn failures_leave_nothing_behind() {
         let dir = tempfile::tempdir().unwrap();
