@@ -38,15 +38,21 @@ impl Material {
                 // Step half a square inward so that points on a face that lies
                 // on a cell boundary (a floor at y = 0) all fall in one cell.
                 let q = (p - n * (0.5 * scale)) / scale;
-                let parity = q.x.floor() as i64 + q.y.floor() as i64 + q.z.floor() as i64;
+                // Wrapping: a tiny scale sends the cell numbers to ±2⁶³.
+                let parity = (q.x.floor() as i64).wrapping_add(q.y.floor() as i64).wrapping_add(q.z.floor() as i64);
                 if parity.rem_euclid(2) == 0 { albedo } else { albedo2 }
             }
         }
     }
 
     /// The BRDF for outgoing `wo` and incident `wi` (both pointing away from
-    /// the surface) at `p`, with geometric normal `n` facing either way.
+    /// the surface) at `p`, with geometric normal `n` facing either way. Zero
+    /// when they lie on opposite sides: surfaces reflect on both sides but
+    /// let no light through (a wall lit from behind is dark in front).
     pub fn brdf(&self, p: Vec3, n: Vec3, wo: Vec3, wi: Vec3) -> Rgb {
+        if n.dot(wo) * n.dot(wi) <= 0.0 {
+            return Rgb::ZERO;
+        }
         let diffuse = self.albedo(p, n) / PI;
         match *self {
             Material::Phong { specular, exponent, .. } => {
@@ -185,6 +191,32 @@ mod tests {
             }
             let est = sum / n as f32;
             assert!((est.x - reference.x).abs() < 0.01, "{m:?}: {est} vs {reference}");
+        }
+    }
+
+    #[test]
+    fn no_light_passes_through_a_surface() {
+        // Directional albedo from the whole sphere of directions: what a
+        // two-sided surface reflects toward wo, from wo's side only (light
+        // arriving from behind would be transmission, which diffuse walls
+        // do not do).
+        let mut s = Sampler::for_pixel(5, 2, 1);
+        for m in [Material::diffuse(Rgb::splat(0.6)), Material::phong(Rgb::splat(0.3), Rgb::splat(0.2), 20.0)] {
+            for wo in [Vec3::Z, -Vec3::Z, Vec3::new(0.3, 0.2, -0.9).normalize()] {
+                let n = 100_000;
+                let mut total = Rgb::ZERO;
+                for _ in 0..n {
+                    let wi = uniform_sphere(s.next2());
+                    total += m.brdf(Vec3::ZERO, Vec3::Z, wo, wi) * wi.z.abs() * (4.0 * PI);
+                }
+                let behind = (0..1000)
+                    .map(|_| uniform_sphere(s.next2()))
+                    .filter(|wi| wi.z * wo.z < 0.0)
+                    .all(|wi| m.brdf(Vec3::ZERO, Vec3::Z, wo, wi) == Rgb::ZERO);
+                assert!(behind, "{m:?}: light from behind reflected toward {wo}");
+                let albedo = total / n as f32;
+                assert!(albedo.x <= 0.62, "{m:?} toward {wo}: directional albedo {albedo} over the sphere");
+            }
         }
     }
 

@@ -44,10 +44,13 @@ impl RadiosityIntegrator {
 }
 
 /// The light a radiosity solution reflects at `s` toward a ray arriving
-/// along `dir`: ρ/π times the indirect irradiance on the side facing it.
-pub fn indirect_radiance(scene: &Scene, solution: &Radiosity, dir: glam::Vec3, s: &SurfaceHit) -> Rgb {
+/// along `dir`: ρ/π times the indirect irradiance on the side facing it,
+/// interpolated from the patches `s` sees (with `seen`, a shadow ray per
+/// nearby patch) or from all nearby patches.
+pub fn indirect_radiance(scene: &Scene, solution: &Radiosity, dir: glam::Vec3, s: &SurfaceHit, seen: bool) -> Rgb {
     let n = if s.n.dot(dir) <= 0.0 { s.n } else { -s.n };
-    match solution.irradiance_at(s.p, n) {
+    let e = if seen { solution.irradiance_seen_at(s.p, n, scene.geometry()) } else { solution.irradiance_at(s.p, n) };
+    match e {
         Some(e) => scene.material_at(s).albedo(s.p, s.n) * FRAC_1_PI * e,
         None => Rgb::ZERO,
     }
@@ -59,7 +62,7 @@ impl Integrator for RadiosityIntegrator {
             scene,
             ray,
             sampler,
-            |s| indirect_radiance(scene, &self.solution, ray.dir, s),
+            |s| indirect_radiance(scene, &self.solution, ray.dir, s, true),
             |medium, length, sampler| march(scene, medium, ray, length, self.march, sampler),
         )
     }

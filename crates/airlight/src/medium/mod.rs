@@ -2,8 +2,10 @@
 //! transmittance in closed form for both.
 
 mod phase;
+mod profile;
 
 pub use phase::{henyey_greenstein, isotropic, sample_henyey_greenstein_cos};
+pub use profile::DensityProfile;
 
 use crate::Rgb;
 use glam::Vec3;
@@ -56,45 +58,51 @@ impl Medium {
         }
     }
 
+    /// The density along the line o + t·d (d unit) as ρ(t) = e^{ln ρ0 − a t}
+    /// (profile.rs), for media where it has that closed form: all of them so
+    /// far. A medium without one (a grid, say) would return None and be
+    /// sampled by tracking against a majorant.
+    pub fn profile(&self, o: Vec3, d: Vec3) -> Option<DensityProfile> {
+        Some(match self.density {
+            Density::Homogeneous => DensityProfile { ln_rho0: 0.0, a: 0.0 },
+            Density::Height { base, falloff } => {
+                let k = falloff as f64;
+                DensityProfile { ln_rho0: -k * (o.y as f64 - base as f64), a: k * d.y as f64 }
+            }
+        })
+    }
+
+    /// Whether the density along every line has the closed form of
+    /// [`Medium::profile`], so that free flights can be drawn and
+    /// transmittance taken exactly.
+    pub fn has_closed_form(&self) -> bool {
+        self.profile(Vec3::ZERO, Vec3::Y).is_some()
+    }
+
     /// ∫ density over the segment o + t·d, t in [t0, t1], d unit; t1 may be
     /// infinite. In closed form for the height fog: with y(t) = o.y + t·d.y
     /// and a = falloff·d.y,
     /// ∫ e^{−falloff (y(t) − base)} dt = ρ(t0)·(1 − e^{−a (t1 − t0)})/a,
-    /// evaluated with expm1 (and its limit t1 − t0 as a → 0) in f64.
+    /// evaluated in f64 from the segment's denser end ([`DensityProfile::integral`]).
     pub fn density_integral(&self, o: Vec3, d: Vec3, t0: f32, t1: f32) -> f64 {
-        let length = t1 as f64 - t0 as f64;
-        if length.is_nan() || length <= 0.0 {
-            return 0.0;
-        }
-        match self.density {
-            Density::Homogeneous => length,
-            Density::Height { base, falloff } => {
-                let k = falloff as f64;
-                let rho0 = (-k * (o.y as f64 + t0 as f64 * d.y as f64 - base as f64)).exp();
-                let a = k * d.y as f64;
-                if length.is_infinite() {
-                    return if a > 0.0 {
-                        rho0 / a
-                    } else if rho0 == 0.0 {
-                        0.0
-                    } else {
-                        f64::INFINITY
-                    };
-                }
-                let x = a * length;
-                if x.abs() < 1e-8 { rho0 * length * (1.0 - 0.5 * x) } else { rho0 * -(-x).exp_m1() / a }
-            }
+        match self.profile(o, d) {
+            Some(profile) => profile.integral(t0 as f64, t1 as f64),
+            None => 0.0,
         }
     }
 
     /// Optical depth σt·∫density over the segment, per channel.
     pub fn optical_depth(&self, o: Vec3, d: Vec3, t0: f32, t1: f32) -> Rgb {
-        let sigma_t = self.sigma_t();
-        if sigma_t == Rgb::ZERO {
+        if self.is_vacuum() {
             return Rgb::ZERO;
         }
-        let integral = self.density_integral(o, d, t0, t1);
-        // σt = 0 channels stay 0 even over infinite lengths.
+        self.optical_depth_of(self.density_integral(o, d, t0, t1))
+    }
+
+    /// σt·X per channel for a density integral X; σt = 0 channels stay 0
+    /// even for an infinite X.
+    pub fn optical_depth_of(&self, integral: f64) -> Rgb {
+        let sigma_t = self.sigma_t();
         Rgb::new(scaled(sigma_t.x, integral), scaled(sigma_t.y, integral), scaled(sigma_t.z, integral))
     }
 
@@ -102,6 +110,38 @@ impl Medium {
     pub fn transmittance(&self, o: Vec3, d: Vec3, t0: f32, t1: f32) -> Rgb {
         let tau = self.optical_depth(o, d, t0, t1);
         Rgb::new((-tau.x).exp(), (-tau.y).exp(), (-tau.z).exp())
+    }
+
+    /// exp(−σt·X) per channel for a density integral X (1 where σt = 0).
+    pub fn transmittance_of(&self, integral: f64) -> Rgb {
+        let tau = self.optical_depth_of(integral);
+        Rgb::new((-tau.x).exp(), (-tau.y).exp(), (-tau.z).exp())
+    }
+
+    /// σs(t)·T(0, t) per channel along o + t·d: the density in t of a
+    /// free flight from o that scatters first at t (σt·ρ(t)·T(0, t) is the
+    /// density of the first collision, σs/σt of which scatter). In f64 as
+    /// σs·e^{ln ρ(t) − σt X(t)}, so that where ρ overflows and T underflows
+    /// the product stays finite (capped at f32::MAX deep below a height fog's
+    /// base, where ρ alone overflows f32). Zero where the medium has no closed form.
+    pub fn free_flight_scattering(&self, o: Vec3, d: Vec3, t: f32) -> Rgb {
+        let Some(profile) = self.profile(o, d) else { return Rgb::ZERO };
+        let ln_rho = profile.ln_rho0 - profile.a * t as f64;
+        let x = profile.integral(0.0, t as f64);
+        let channel = |sigma_s: f32, sigma_t: f32| {
+            // Capped at f32::MAX: callers divide it by sums that hold it.
+            if sigma_s == 0.0 {
+                0.0
+            } else {
+                (sigma_s as f64 * (ln_rho - sigma_t as f64 * x).exp()).min(f32::MAX as f64) as f32
+            }
+        };
+        let sigma_t = self.sigma_t();
+        Rgb::new(
+            channel(self.sigma_s.x, sigma_t.x),
+            channel(self.sigma_s.y, sigma_t.y),
+            channel(self.sigma_s.z, sigma_t.z),
+        )
     }
 
     /// The phase function for directions `wo`, `wi` pointing away from the

@@ -97,7 +97,7 @@ impl Integrator for Preview<'_> {
             scene,
             ray,
             sampler,
-            |s| self.solution.map_or(Rgb::ZERO, |solution| indirect_radiance(scene, solution, ray.dir, s)),
+            |s| self.solution.map_or(Rgb::ZERO, |solution| indirect_radiance(scene, solution, ray.dir, s, false)),
             |medium, length, sampler| self.glow(scene, medium, ray, length, sampler),
         )
     }

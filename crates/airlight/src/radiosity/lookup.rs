@@ -62,6 +62,23 @@ impl Lookup {
     where
         T: std::ops::Mul<f32, Output = T> + std::ops::Add<Output = T> + Default,
     {
+        self.interpolate_where(patches, p, n, |_| true, value)
+    }
+
+    /// [`Lookup::interpolate`] over the patches that `keep(i)` accepts (the
+    /// radiosity integrator keeps those that `p` sees, so that light does
+    /// not blend across a wall).
+    pub fn interpolate_where<T>(
+        &self,
+        patches: &[Patch],
+        p: Vec3,
+        n: Vec3,
+        keep: impl Fn(usize) -> bool,
+        value: impl Fn(usize) -> T,
+    ) -> Option<T>
+    where
+        T: std::ops::Mul<f32, Output = T> + std::ops::Add<Output = T> + Default,
+    {
         let r = self.radius;
         let lo = ((p - r) / r).floor().as_ivec3();
         let hi = ((p + r) / r).floor().as_ivec3();
@@ -99,7 +116,7 @@ impl Lookup {
                             continue;
                         }
                         let dist = d.length();
-                        if dist >= r {
+                        if dist >= r || !keep(i as usize) {
                             continue;
                         }
                         let w = (1.0 - dist / r) * facing;

@@ -51,9 +51,16 @@ use std::time::{Duration, Instant};
 /// default threshold; see docs/radiosity-bench.md).
 pub const MAX_PATCHES: usize = 2_000_000;
 
+/// Peak bytes of compilation per patch (links collected before packing;
+/// 753 MB at 100,451 patches in docs/radiosity-bench.md), for the
+/// up-front memory check.
+pub const PEAK_BYTES_PER_PATCH: u64 = 8 << 10;
+
 /// Why a scene cannot be compiled.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum RadiosityError {
+    #[error("radiosity: {0}; choose a larger render.patch_size")]
+    Memory(#[from] crate::memory::MemoryError),
     #[error(
         "render.patch_size = {patch_size} would cut the scene into about {estimated} patches; \
          at most {MAX_PATCHES} are allowed: choose a larger patch_size"
@@ -192,6 +199,8 @@ impl Radiosity {
         if estimated.is_nan() || estimated > MAX_PATCHES as f64 {
             return Err(RadiosityError::TooManyPatches { patch_size: params.patch_size, estimated });
         }
+        let what = format!("compiling about {} patches (patch_size {})", estimated.round(), params.patch_size);
+        crate::memory::check(what, estimated as u64 * PEAK_BYTES_PER_PATCH)?;
         for (index, (shape, material)) in scene.objects().iter().enumerate() {
             let inner = enclosures::holds_light(shape, scene.lights(), scene.light_paths());
             patches::cut(shape, *material, index as u32, params.patch_size, square, inner, &mut patches);
@@ -312,6 +321,34 @@ impl Radiosity {
     /// no patch is near (a side dropped as seeing nothing).
     pub fn irradiance_at(&self, p: Vec3, n: Vec3) -> Option<Rgb> {
         self.lookup.interpolate(&self.patches, p, n, |i| self.indirect[i])
+    }
+
+    /// [`Radiosity::irradiance_at`] from the patches that `p` sees in
+    /// `geometry`: a point near a wall does not take the light of patches
+    /// on its other side (a floor that runs under a wall into the sun). It
+    /// costs a shadow ray per nearby patch; the viewer's preview does
+    /// without.
+    pub fn irradiance_seen_at(&self, p: Vec3, n: Vec3, geometry: &crate::geometry::Geometry) -> Option<Rgb> {
+        // The path from p to a patch's centre runs just above the surface
+        // (lifted by ε at both ends), bent at its middle over a curved one: a
+        // ball's chord dips below its surface by d·θ/8 (θ the angle between
+        // the two normals), so the middle is lifted by twice that. A wall
+        // between them, or the far face of a thin slab, still stops it.
+        let epsilon = 1e-3 * self.lookup.radius();
+        let clear = |a: Vec3, b: Vec3| {
+            let to = b - a;
+            let length = to.length();
+            length <= 0.0 || !geometry.occluded(a, to / length, length * (1.0 - 1e-4))
+        };
+        let sees = |i: usize| {
+            let patch = &self.patches[i];
+            let (from, to) = (p + n * epsilon, patch.center + patch.normal * epsilon);
+            let angle = n.dot(patch.normal).clamp(-1.0, 1.0).acos();
+            let up = (n + patch.normal).normalize_or(n);
+            let middle = 0.5 * (from + to) + up * (0.25 * angle * from.distance(to) + epsilon);
+            clear(from, middle) && clear(middle, to)
+        };
+        self.lookup.interpolate_where(&self.patches, p, n, sees, |i| self.indirect[i])
     }
 
     pub fn params(&self) -> CompileParams {

@@ -1,9 +1,10 @@
 //! The reference: unidirectional volumetric path tracing with next-event
 //! estimation, multiple importance sampling and Russian roulette, built as
 //! pbrt-v4's VolPathIntegrator is (Pharr, Jakob and Humphreys, "Physically
-//! Based Rendering", 4th ed., ch. 14): free flights against a majorant
-//! (closed-form distance sampling where the majorant is exact, delta
-//! tracking where it is not), one hero channel sampled per path and the
+//! Based Rendering", 4th ed., ch. 14): free flights drawn exactly by
+//! inverting the closed-form optical depth (homogeneous and height fog;
+//! delta tracking against a majorant for media without one, tracking.rs),
+//! one hero channel sampled per path and the
 //! path weighted by the balance heuristic over the three channels (r_u and
 //! r_l hold each channel's unidirectional and light-sampling path pdfs
 //! relative to the hero's).
@@ -18,8 +19,8 @@ use crate::medium::{henyey_greenstein, sample_henyey_greenstein_cos};
 use crate::sampling::{Sampler, to_world};
 use crate::scene::Scene;
 use glam::Vec3;
-use nee::{Along, Segment, direct_light, equiangular_applies, equiangular_light};
-use tracking::track;
+use nee::{Along, Fog, Segment, direct_light, equiangular_applies, equiangular_light};
+use tracking::free_flight;
 
 /// Volumetric path tracer. `max_depth` counts scattering events: 1 is direct
 /// light on surfaces plus single scattering in the medium (pbrt-v4's
@@ -27,14 +28,20 @@ use tracking::track;
 pub struct PathTracer {
     pub max_depth: u32,
     /// Also sample delta lights' scattered light equiangularly along each
-    /// segment through a homogeneous medium, with MIS (nee.rs). On by
-    /// default; off is free-flight sampling alone, as Mitsuba's volpath.
+    /// segment through a medium with a closed-form optical depth, with MIS
+    /// (nee.rs). On by default; off is free-flight sampling alone, as
+    /// Mitsuba's volpath.
     pub equiangular: bool,
+    /// Draw free flights and shadow rays' transmittance from the medium's
+    /// closed-form optical depth where it has one. On by default; off is
+    /// delta and ratio tracking against a majorant for every medium (and no
+    /// equiangular sampling), as for media without a closed form.
+    pub closed_form: bool,
 }
 
 impl PathTracer {
     pub fn new(options: PathOptions) -> Self {
-        PathTracer { max_depth: options.max_depth, equiangular: true }
+        PathTracer { max_depth: options.max_depth, equiangular: true, closed_form: true }
     }
 }
 
@@ -77,13 +84,14 @@ impl Integrator for PathTracer {
                 // equiangular points (nee.rs), when a scattering event here
                 // would still count.
                 let segment = Segment { ray, length: t_medium };
-                let equiangular = self.equiangular && depth < self.max_depth && equiangular_applies(m);
+                let equiangular =
+                    self.equiangular && self.closed_form && depth < self.max_depth && equiangular_applies(m);
                 if equiangular {
                     l += equiangular_light(scene, m, &segment, beta, r_u, hero, sampler);
                 }
                 let mut scattered: Option<Ray> = None;
                 let mut terminated = false;
-                let t_maj = track(m, &ray, t_medium, hero, sampler, |c, sampler| {
+                let t_maj = free_flight(m, &ray, t_medium, hero, self.closed_form, sampler, |c, sampler| {
                     let p_absorb = c.sigma_a[hero] / c.sigma_maj[hero];
                     let p_scatter = c.sigma_s[hero] / c.sigma_maj[hero];
                     let u = sampler.next();
@@ -107,7 +115,16 @@ impl Integrator for PathTracer {
                         let p = ray.at(c.t);
                         let wo = -ray.dir;
                         let vertex = Vertex::Medium { p, along };
-                        l += beta * direct_light(scene, m.into(), &vertex, wo, r_u, hero, sampler);
+                        l += beta
+                            * direct_light(
+                                scene,
+                                Fog { medium: Some(m), closed_form: self.closed_form },
+                                &vertex,
+                                wo,
+                                r_u,
+                                hero,
+                                sampler,
+                            );
                         // Phase sampling: its weight p/pdf is 1.
                         let cos = sample_henyey_greenstein_cos(m.g, sampler.next());
                         let sin = (1.0 - cos * cos).max(0.0).sqrt();
@@ -177,7 +194,8 @@ impl Integrator for PathTracer {
             let material = scene.material_at(&surface);
             let wo = -ray.dir;
             let vertex = Vertex::Surface { p: surface.p, n: surface.n, material: surface.material };
-            l += beta * direct_light(scene, medium, &vertex, wo, r_u, hero, sampler);
+            l += beta
+                * direct_light(scene, Fog { medium, closed_form: self.closed_form }, &vertex, wo, r_u, hero, sampler);
             let Some(bs) = material.sample(surface.p, surface.n, wo, sampler.next2(), sampler.next()) else {
                 return l;
             };

@@ -1,5 +1,6 @@
 //! Next-event estimation: light sampled from a vertex, and light sampled
-//! along a segment of a ray through a homogeneous medium.
+//! along a segment of a ray through a medium whose optical depth has a
+//! closed form (homogeneous or height fog).
 //!
 //! Near a point or spot light in a medium the single-scattered light grows
 //! as 1/r², and a collision found by free-flight sampling lands there too
@@ -11,10 +12,16 @@
 //! scattered along the segment are combined by the balance heuristic
 //! (Veach 1997). With the hero-channel weights of mod.rs, both strategies'
 //! densities of the scattering point at t, relative to the hero path's
-//! prefix, are r_u,c·σs,c·T_c(t) (free flight in channel c) and r_u,c·p_eq(t)
-//! (equiangular), so either sample contributes
-//! β·σs·T(t)·f_phase·T_light·I/r² / avg_c(r_u,c·r_l,c·(σs,c·T_c(t) + p_eq(t))),
-//! r_l the shadow ray's transmittance ratios.
+//! prefix, are r_u,c·σs,c(t)·T_c(t) (free flight in channel c: the first
+//! collision's density σt,c(t)·T_c(t) times the chance σs/σt that it
+//! scatters) and r_u,c·p_eq(t) (equiangular), so either sample contributes
+//! β·σs(t)·T(t)·f_phase·T_light·I/r² / avg_c(r_u,c·r_l,c·(σs,c(t)·T_c(t) + p_eq(t))),
+//! r_l the shadow ray's transmittance ratios. In height fog σs(t) = σs·ρ(t)
+//! varies along the segment: the density at the sampled point enters the
+//! integrand and the free-flight pdf alike, and each sample's weight is
+//! still its own pdf over the sum of both, so the two weights sum to one at
+//! every t and the combination stays unbiased. Where a medium has no closed
+//! form the free-flight pdf is unknown and equiangular sampling is not used.
 
 use super::tracking::track;
 use super::{Vertex, avg};
@@ -22,12 +29,14 @@ use crate::Rgb;
 use crate::geometry::{Ray, offset_origin};
 use crate::integrator::Equiangular;
 use crate::light::Light;
-use crate::medium::{Density, Medium};
+use crate::medium::Medium;
 use crate::sampling::{Sampler, keyed2};
 use crate::scene::Scene;
+use crate::scene::light_numbers;
 use glam::Vec3;
 
-/// A ray's stretch [0, length] through a homogeneous medium.
+/// A ray's stretch [0, length] through a medium with a closed-form
+/// optical depth.
 #[derive(Clone, Copy)]
 pub(super) struct Segment {
     pub ray: Ray,
@@ -88,31 +97,40 @@ pub(super) fn equiangular_light(
         let t = equiangular.sample(u.x);
         let pdf = equiangular.pdf(t);
         let p = segment.ray.at(t);
-        let Some(ls) = light.sample(p, keyed2(key, 2 * index as u64 + 1)) else { continue };
-        let phase = medium.phase(wo, ls.wi);
-        if pdf <= 0.0 || !pdf.is_finite() || phase <= 0.0 || ls.weight == Rgb::ZERO {
+        let Some(ls) = scene.sample_light(index, p, light_numbers(keyed2(key, 2 * index as u64 + 1))) else {
             continue;
-        }
-        if !scene.light_visible(p, p, ls.wi, ls.distance) {
+        };
+        let phase = medium.phase(wo, ls.wi);
+        if pdf <= 0.0 || !pdf.is_finite() || phase <= 0.0 || !scene.unoccluded(p, None, &ls) {
             continue;
         }
         let t_light = medium.transmittance(p, ls.wi, 0.0, scene.light_distance(ls.distance));
-        let t_view = medium.transmittance(segment.ray.origin, segment.ray.dir, 0.0, t);
         if t_light[hero] <= 0.0 {
             continue;
         }
         let r_l = t_light / t_light[hero];
-        let free_flight = medium.sigma_s * t_view;
+        // σs(t)·T(0, t), the integrand's medium term and the free-flight
+        // pdf in one.
+        let free_flight = medium.free_flight_scattering(segment.ray.origin, segment.ray.dir, t);
         let denominator = avg(r_u * r_l * (free_flight + Rgb::splat(pdf)));
-        total += beta * free_flight * t_light * ls.weight * (phase / denominator);
+        // The ratio first: deep in fog both can be near f32::MAX.
+        total += beta * (free_flight / denominator) * t_light * ls.weight * phase;
     }
     total
 }
 
-/// Whether equiangular sampling applies to a medium: homogeneous (where
-/// free-flight densities are closed form) and scattering.
+/// Whether equiangular sampling applies to a medium: one whose free-flight
+/// densities are closed form (homogeneous or height fog), and scattering.
 pub(super) fn equiangular_applies(medium: &Medium) -> bool {
-    matches!(medium.density, Density::Homogeneous) && medium.sigma_s.max_element() > 0.0
+    medium.has_closed_form() && medium.sigma_s.max_element() > 0.0
+}
+
+/// The medium a path travels through (if any) and whether its
+/// transmittance is taken in closed form (mod.rs, `PathTracer::closed_form`).
+#[derive(Clone, Copy)]
+pub(super) struct Fog<'a> {
+    pub medium: Option<&'a Medium>,
+    pub closed_form: bool,
 }
 
 /// Next-event estimation at a vertex: a sample of every light that reaches
@@ -123,7 +141,7 @@ pub(super) fn equiangular_applies(medium: &Medium) -> bool {
 /// contribution to be multiplied by the path weight β.
 pub(super) fn direct_light(
     scene: &Scene,
-    medium: Option<&Medium>,
+    fog: Fog,
     vertex: &Vertex,
     wo: Vec3,
     r_p: Rgb,
@@ -131,6 +149,7 @@ pub(super) fn direct_light(
     sampler: &mut Sampler,
 ) -> Rgb {
     let p = vertex.p();
+    let medium = fog.medium;
     let along = match vertex {
         Vertex::Medium { along, .. } => along.as_ref(),
         Vertex::Surface { .. } => None,
@@ -138,63 +157,58 @@ pub(super) fn direct_light(
     let key = sampler.next_key();
     let mut total = Rgb::ZERO;
     scene.for_each_light_at(p, |index, light| {
-        let Some(ls) = light.sample(p, keyed2(key, index as u64)) else { return };
-        let (f, scatter_pdf, origin) = match *vertex {
+        let Some(ls) = scene.sample_light(index, p, light_numbers(keyed2(key, index as u64))) else { return };
+        let (f, scatter_pdf, normal) = match *vertex {
             Vertex::Surface { p, n, material } => {
                 let m = scene.material(material);
                 let f = m.brdf(p, n, wo, ls.wi) * ls.wi.dot(n).abs();
-                (f, m.pdf(p, n, wo, ls.wi), offset_origin(p, n, ls.wi))
+                (f, m.pdf(p, n, wo, ls.wi), Some(n))
             }
-            Vertex::Medium { p, .. } => {
+            Vertex::Medium { .. } => {
                 let phase = medium.map_or(0.0, |m| m.phase(wo, ls.wi));
-                (Rgb::splat(phase), phase, p)
+                (Rgb::splat(phase), phase, None)
             }
         };
-        if f == Rgb::ZERO || ls.weight == Rgb::ZERO {
+        if f == Rgb::ZERO || !scene.unoccluded(p, normal, &ls) {
             return;
         }
+        let origin = normal.map_or(p, |n| offset_origin(p, n, ls.wi));
         let distance = scene.light_distance(ls.distance);
-        if !scene.light_visible(p, origin, ls.wi, ls.distance) {
-            return;
-        }
         let (mut t_ray, mut r_l, mut r_u) = (Rgb::ONE, Rgb::ONE, Rgb::ONE);
         if let Some(m) = medium {
-            let shadow = Ray::new(origin, ls.wi);
-            match m.density {
-                // Exact transmittance where it is cheap. The MIS ratios get
-                // T/T[hero], the expected factor of ratio tracking, so that
-                // both strategies' pdfs carry the transmittance per channel
-                // as they do at emitter hits.
-                Density::Homogeneous => {
-                    t_ray = m.transmittance(origin, ls.wi, 0.0, distance);
-                    if t_ray[hero] <= 0.0 {
-                        return;
-                    }
-                    r_l = t_ray / t_ray[hero];
-                    r_u = r_l;
+            if fog.closed_form && m.has_closed_form() {
+                // Exact transmittance. The MIS ratios get T/T[hero], the
+                // expected factor of ratio tracking, so that both
+                // strategies' pdfs carry the transmittance per channel as
+                // they do at emitter hits.
+                t_ray = m.transmittance(origin, ls.wi, 0.0, distance);
+                if t_ray[hero] <= 0.0 {
+                    return;
                 }
-                Density::Height { .. } => {
-                    let t_maj = track(m, &shadow, distance, hero, sampler, |c, sampler| {
-                        let sigma_n = (c.sigma_maj - c.sigma_a - c.sigma_s).max(Rgb::ZERO);
-                        let pdf = c.t_maj[hero] * c.sigma_maj[hero];
-                        t_ray *= c.t_maj * sigma_n / pdf;
-                        r_l *= c.t_maj * c.sigma_maj / pdf;
-                        r_u *= c.t_maj * sigma_n / pdf;
-                        // Roulette on small transmittance.
-                        let tr = t_ray / avg(r_l + r_u);
-                        if tr.max_element() < 0.05 {
-                            if sampler.next() < 0.75 {
-                                t_ray = Rgb::ZERO;
-                            } else {
-                                t_ray /= 0.25;
-                            }
+                r_l = t_ray / t_ray[hero];
+                r_u = r_l;
+            } else {
+                let shadow = Ray::new(origin, ls.wi);
+                let t_maj = track(m, &shadow, distance, hero, sampler, |c, sampler| {
+                    let sigma_n = (c.sigma_maj - c.sigma_a - c.sigma_s).max(Rgb::ZERO);
+                    let pdf = c.t_maj[hero] * c.sigma_maj[hero];
+                    t_ray *= c.t_maj * sigma_n / pdf;
+                    r_l *= c.t_maj * c.sigma_maj / pdf;
+                    r_u *= c.t_maj * sigma_n / pdf;
+                    // Roulette on small transmittance.
+                    let tr = t_ray / avg(r_l + r_u);
+                    if tr.max_element() < 0.05 {
+                        if sampler.next() < 0.75 {
+                            t_ray = Rgb::ZERO;
+                        } else {
+                            t_ray /= 0.25;
                         }
-                        t_ray.max_element() > 0.0
-                    });
-                    t_ray *= t_maj / t_maj[hero];
-                    r_l *= t_maj / t_maj[hero];
-                    r_u *= t_maj / t_maj[hero];
-                }
+                    }
+                    t_ray.max_element() > 0.0
+                });
+                t_ray *= t_maj / t_maj[hero];
+                r_l *= t_maj / t_maj[hero];
+                r_u *= t_maj / t_maj[hero];
             }
         }
         if t_ray == Rgb::ZERO {

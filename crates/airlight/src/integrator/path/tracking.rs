@@ -1,13 +1,79 @@
-//! Free-flight sampling in media against a majorant: delta tracking (Woodcock
-//! et al. 1965) for distances and ratio tracking (Novák, Selle and Jarosz
-//! 2014) for transmittance, written as in pbrt-v4's majorant iteration so
-//! that RGB coefficients are handled by sampling one "hero" channel and
-//! weighting all three by the ratios of their path pdfs (spectral MIS).
+//! Free-flight sampling in media: exactly, by inverting the closed-form
+//! optical depth, where the medium has one (homogeneous and height fog);
+//! else against a majorant, by delta tracking (Woodcock et al. 1965) for
+//! distances and ratio tracking (Novák, Selle and Jarosz 2014) for
+//! transmittance. Both are written as pbrt-v4's majorant iteration, so that
+//! RGB coefficients are handled by sampling one "hero" channel and
+//! weighting all three by the ratios of their path pdfs (spectral MIS); an
+//! exact flight is the case σ_maj = σt(p), where no collision is null.
 
 use crate::Rgb;
 use crate::geometry::Ray;
-use crate::medium::{Density, Medium};
+use crate::medium::{Density, DensityProfile, Medium};
 use crate::sampling::Sampler;
+
+/// Walks [0, t_max] of `ray` from collision to collision as [`track`]
+/// does, drawing each flight exactly from the medium's closed-form optical
+/// depth when `closed_form` is set and the medium has one, else tracking
+/// against a majorant.
+pub fn free_flight(
+    medium: &Medium,
+    ray: &Ray,
+    t_max: f32,
+    hero: usize,
+    closed_form: bool,
+    sampler: &mut Sampler,
+    at: impl FnMut(Collision, &mut Sampler) -> bool,
+) -> Rgb {
+    match medium.profile(ray.origin, ray.dir).filter(|_| closed_form) {
+        Some(profile) => exact_flights(medium, &profile, t_max, hero, sampler, at),
+        None => track(medium, ray, t_max, hero, sampler, at),
+    }
+}
+
+/// [`track`] with the majorant equal to σt(p) everywhere: each flight ends
+/// where the hero channel's optical depth σt·X(t) reaches an exponential
+/// variate E, t = X⁻¹(X(t_prev) + E/σt) (medium/profile.rs), so every
+/// collision is real. The majorant transmittance since the previous
+/// collision is e^{−σt ΔX} from the density integrals, not from the f32
+/// distances. Where ρ overflows f32 (far below a height fog's base) the
+/// reported coefficients are scaled down together: callers only take their
+/// ratios.
+fn exact_flights(
+    medium: &Medium,
+    profile: &DensityProfile,
+    t_max: f32,
+    hero: usize,
+    sampler: &mut Sampler,
+    mut at: impl FnMut(Collision, &mut Sampler) -> bool,
+) -> Rgb {
+    let sigma_t = medium.sigma_t();
+    let x_max = profile.integral(0.0, t_max as f64);
+    if sigma_t[hero] <= 0.0 {
+        return medium.transmittance_of(x_max);
+    }
+    let cap = f32::MAX as f64 / (2.0 * sigma_t.max_element() as f64).max(1.0);
+    let mut x = 0.0f64;
+    loop {
+        let step = -((1.0 - sampler.next()) as f64).ln() / sigma_t[hero] as f64;
+        if x + step >= x_max {
+            return medium.transmittance_of(x_max - x);
+        }
+        x += step;
+        let t = (profile.distance_to(x) as f32).min(t_max);
+        let density = profile.density(t as f64).min(cap) as f32;
+        let collision = Collision {
+            t,
+            sigma_a: medium.sigma_a * density,
+            sigma_s: medium.sigma_s * density,
+            sigma_maj: sigma_t * density,
+            t_maj: medium.transmittance_of(step),
+        };
+        if !at(collision, sampler) {
+            return Rgb::ONE;
+        }
+    }
+}
 
 /// A bound σ_maj ≥ σt(p) over the segment [t0, t1] of `ray`, per channel.
 /// Exact for a homogeneous medium; for the height fog, whose density is
