@@ -560,6 +560,11 @@ fn bounding_sphere(geometry: &Geometry, lights: &[Light], camera: &Camera) -> (V
                     grow(p);
                 }
             }
+            Light::Triangle { a, edge_1, edge_2, .. } => {
+                for p in [a, a + edge_1, a + edge_2] {
+                    grow(p);
+                }
+            }
             Light::Line { start, end, .. } => {
                 grow(start);
                 grow(end);
