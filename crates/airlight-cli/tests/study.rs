@@ -182,13 +182,18 @@ fn bad_options_give_clear_errors_before_any_render() {
     let dir = tempfile::tempdir().unwrap();
     std::fs::write(dir.path().join("full").with_extension("txt"), "x").unwrap();
     let cornell = scene("cornell_box.toml");
-    let cases: [(&[&str], &str); 6] = [
+    let cases: [(&[&str], &str); 11] = [
         (&["--time-budget", "0"], "number of seconds"),
         (&["--time-budget", "nan"], "number of seconds"),
         (&["--truth-error", "1.5"], "relative error"),
         (&["--integrators", "path,magic"], "unknown integrator"),
+        (&["--threads", "5000"], "4096"),
+        (&["--width", "70000"], "65536"),
         (&["-o", "."], "not empty"),
         (&["--json", "missing/s.json", "-o", "r"], "cannot write"),
+        (&["--json", &cornell, "-o", "r"], "would replace an input"),
+        (&["--json", "r/index.html", "-o", "r"], "are the same file"),
+        (&["--json", "r", "-o", "r"], "it is a folder"),
     ];
     for (args, expected) in cases {
         let out = airlight(dir.path(), &[&["study", &cornell, "--quiet"][..], args].concat());
@@ -196,7 +201,20 @@ fn bad_options_give_clear_errors_before_any_render() {
         assert!(!out.status.success(), "{args:?}");
         assert!(stderr.contains(expected), "{args:?}: {stderr}");
         assert!(!stderr.contains("panicked"), "{stderr}");
+        // Refused before any render: no report folder is left behind.
+        assert!(!dir.path().join("r").exists(), "{args:?} left r/");
     }
+    // Images that would not fit in memory (here a 64 MB limit) are refused
+    // up front, with the size that would.
+    let out = Command::new(env!("CARGO_BIN_EXE_airlight"))
+        .current_dir(dir.path())
+        .env("AIRLIGHT_MEMORY_LIMIT", "64M")
+        .args(["study", &cornell, "--width", "2000", "--height", "2000", "--time-budget", "5", "-o", "r", "--quiet"])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success() && stderr.contains("2000×2000 study needs about"), "{stderr}");
+    assert!(!dir.path().join("r").exists());
     let out = airlight(dir.path(), &["study", "no-such.toml"]);
     assert!(!out.status.success() && String::from_utf8_lossy(&out.stderr).contains("no-such.toml"));
 }

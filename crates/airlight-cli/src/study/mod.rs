@@ -19,11 +19,12 @@ mod steps;
 mod table;
 
 use crate::load;
+use crate::outputs::{self, Output};
 use crate::progress::Progress;
 use airlight::SceneFile;
 use airlight::film::Image;
 use airlight::integrator::IntegratorKind;
-use airlight::scene::{MAX_SPP, Scene};
+use airlight::scene::{MAX_IMAGE_SIDE, MAX_SPP, Scene};
 use data::{State, Study};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -52,15 +53,15 @@ pub struct StudyArgs {
     /// Also write the table, with every figure `airlight compare` gives, as JSON.
     #[arg(long, value_name = "FILE")]
     json: Option<PathBuf>,
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=MAX_IMAGE_SIDE as i64))]
     width: Option<u32>,
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=MAX_IMAGE_SIDE as i64))]
     height: Option<u32>,
     /// Seed of the series; the truths take seeds of their own from it.
     #[arg(long)]
     seed: Option<u64>,
     /// Worker threads (default: all cores).
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=crate::preflight::MAX_THREADS as i64))]
     threads: Option<u32>,
     /// No progress display.
     #[arg(long, short)]
@@ -90,21 +91,65 @@ fn scene_file(args: &StudyArgs) -> Result<SceneFile, String> {
     Ok(file)
 }
 
-/// Creates the report's folders; refuses a non-empty folder that holds no
-/// earlier report, rather than mixing files into it.
-fn prepare_dir(dir: &Path) -> Result<(), String> {
+/// The files at the report's top level, whatever the scene.
+const REPORT_FILES: [&str; 8] = [
+    "index.html",
+    "plot.svg",
+    "plot_single.svg",
+    "truth.exr",
+    "truth.png",
+    "truth_single.exr",
+    "truth_single.png",
+    "multiple_scattering.png",
+];
+
+/// Creates the report's folders, having checked where the study will
+/// write (outputs.rs): the report's files and the JSON may replace neither
+/// the scene nor a file it was read from, nor each other. Refuses a
+/// non-empty folder that holds no earlier report, rather than mixing files
+/// into it.
+fn prepare_dir(dir: &Path, args: &StudyArgs, scene: &Scene) -> Result<(), String> {
     let shown = dir.display();
-    if dir.exists() {
+    let existed = dir.exists();
+    if existed {
         let mut entries = std::fs::read_dir(dir).map_err(|e| format!("cannot read `{shown}`: {e}"))?;
         if entries.next().is_some() && !dir.join("index.html").exists() {
             return Err(format!("`{shown}` is not empty and holds no earlier study: give an empty or new folder"));
         }
     }
-    for sub in ["", "exr", "images"] {
+    outputs::check_folder("-o", dir)?;
+    let files: Vec<PathBuf> = REPORT_FILES.iter().map(|f| dir.join(f)).collect();
+    let mut written: Vec<Output> = files.iter().map(|path| Output { option: "-o", path }).collect();
+    if let Some(json) = &args.json {
+        written.push(Output { option: "--json", path: json });
+    }
+    let inputs: Vec<&Path> =
+        std::iter::once(args.scene.as_path()).chain(scene.files().iter().map(PathBuf::as_path)).collect();
+    if let Err(e) = outputs::check(&written, &inputs) {
+        if !existed {
+            // The folder this call made, empty: nothing is left behind.
+            let _ = std::fs::remove_dir(dir);
+        }
+        return Err(e);
+    }
+    for sub in ["exr", "images"] {
         std::fs::create_dir_all(dir.join(sub))
             .map_err(|e| format!("cannot create `{}`: {e}", dir.join(sub).display()))?;
     }
     Ok(())
+}
+
+/// Refuses a study whose images would not fit in memory: a progressive
+/// render's, and the images it keeps beside it (the truths, the first
+/// image of each of `series` series, a rung's image and error map).
+fn check_memory(scene: &Scene, series: usize) -> Result<(), String> {
+    let s = scene.settings();
+    let pixels = s.width as u64 * s.height as u64;
+    let image = pixels.saturating_mul(size_of::<airlight::Rgb>() as u64);
+    let kept = (series as u64 + 4).saturating_mul(image);
+    let needed = airlight::memory::render_bytes(pixels, true).saturating_add(kept);
+    airlight::memory::check(format!("a {}×{} study", s.width, s.height), needed)
+        .map_err(|e| format!("{e}: make the image smaller (--width, --height)"))
 }
 
 /// Where the study writes and how it keeps time; shared by its steps.
@@ -152,7 +197,9 @@ pub fn study(args: StudyArgs) -> Result<(), String> {
     kinds.dedup();
     let stem = args.scene.file_stem().unwrap_or_default().to_string_lossy();
     let dir = args.output.clone().unwrap_or_else(|| PathBuf::from(format!("{stem}-study")));
-    prepare_dir(&dir)?;
+    check_memory(&scene, plan::ladder(&scene, &desc, &kinds).0.len())?;
+    crate::preflight::warn_if_dark(&scene, true);
+    prepare_dir(&dir, &args, &scene)?;
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(args.threads.unwrap_or(0) as usize)
         .build()
