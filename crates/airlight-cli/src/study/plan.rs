@@ -92,8 +92,12 @@ pub fn ladder(scene: &Scene, base: &IntegratorDesc, kinds: &[IntegratorKind]) ->
                 }
             }
             IntegratorKind::Analytic => {
-                // Light steps only matter for line and quad lights in a medium.
-                let area = scene.lights().iter().any(|l| matches!(l, Light::Line { .. } | Light::Quad { .. }));
+                // Light steps only matter for line, quad and triangle
+                // lights in a medium.
+                let area = scene
+                    .lights()
+                    .iter()
+                    .any(|l| matches!(l, Light::Line { .. } | Light::Quad { .. } | Light::Triangle { .. }));
                 let own = desc.analytic.light_steps;
                 let steps = if medium && area { around(own, MAX_LIGHT_STEPS) } else { vec![own] };
                 let shadows = desc.analytic.shadows;
@@ -159,6 +163,41 @@ fn attenuation_variants(scene: &Scene, base: &IntegratorDesc, plans: &mut Vec<Se
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The analytic series of a foggy scene lit by `light`: their light steps.
+    fn analytic_light_steps(light: Light) -> Vec<u32> {
+        use airlight::prelude::*;
+        let scene = SceneBuilder::new()
+            .size(8, 8)
+            .camera(Camera::look_at(vec3(0.0, 1.0, -5.0), vec3(0.0, 1.0, 0.0), Vec3::Y, 40.0))
+            .material("white", Material::diffuse(Rgb::splat(0.8)))
+            .object(Shape::sphere(vec3(0.0, 1.0, 0.0), 1.0), "white")
+            .light(light)
+            .medium(Medium::homogeneous(Rgb::splat(0.01), Rgb::splat(0.1), 0.0))
+            .build()
+            .unwrap();
+        let desc = IntegratorDesc::new(IntegratorKind::Analytic);
+        let (plans, _) = ladder(&scene, &desc, &[IntegratorKind::Analytic]);
+        plans
+            .iter()
+            .filter(|p| p.desc.analytic.shadows == desc.analytic.shadows)
+            .map(|p| p.desc.analytic.light_steps)
+            .collect()
+    }
+
+    #[test]
+    fn light_steps_vary_for_lights_with_an_extent_only() {
+        use airlight::prelude::{Rgb, vec3};
+        let own = IntegratorDesc::new(IntegratorKind::Analytic).analytic.light_steps;
+        let spread = around(own, MAX_LIGHT_STEPS);
+        assert!(spread.len() > 1);
+        let colour = Rgb::splat(5.0);
+        let (a, b, c) = (vec3(-1.0, 3.0, 0.0), vec3(0.0, 3.0, 1.0), vec3(1.0, 3.0, 0.0));
+        assert_eq!(analytic_light_steps(Light::triangle(a, b, c, colour)), spread);
+        assert_eq!(analytic_light_steps(Light::quad(a, b - a, c - a, colour)), spread);
+        assert_eq!(analytic_light_steps(Light::line(a, c, colour)), spread);
+        assert_eq!(analytic_light_steps(Light::point(a, colour)), [own]);
+    }
 
     #[test]
     fn settings_spread_around_the_scenes_own() {
