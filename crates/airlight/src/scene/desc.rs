@@ -169,6 +169,9 @@ pub struct ObjectDesc {
     pub min: Option<Point>,
     pub max: Option<Point>,
     pub file: Option<Spanned<String>>,
+    /// Radiance the surface emits (sphere, quad and mesh objects): the
+    /// object becomes area lights, one per triangle for a mesh.
+    pub emission: Option<Triple>,
     pub translate: Option<Point>,
     pub rotate: Option<Point>,
     pub scale: Option<Triple>,

@@ -17,6 +17,7 @@ mod error;
 mod lights;
 pub mod limits;
 mod mesh;
+mod mtl;
 pub mod obj;
 mod sdf;
 mod warnings;
