@@ -3,6 +3,7 @@
 
 use super::assets::AssetPath;
 use super::desc::*;
+use super::gltf;
 use super::limits;
 use super::{MAX_IMAGE_SIDE, MAX_SPP, RenderSettings, Scene, SceneBuilder, SceneError, desc};
 use crate::Rgb;
@@ -20,10 +21,10 @@ use toml::Spanned;
 /// materials, the materials it brings (an OBJ's `.mtl`), and the lights
 /// of emitting surfaces.
 #[derive(Default)]
-struct Built {
-    materials: Vec<(String, Material)>,
-    objects: Vec<(Shape, String)>,
-    lights: Vec<Light>,
+pub(super) struct Built {
+    pub materials: Vec<(String, Material)>,
+    pub objects: Vec<(Shape, String)>,
+    pub lights: Vec<Light>,
 }
 
 /// Parses scene file text into its description; errors name the line and
@@ -46,9 +47,17 @@ pub fn build(desc: &SceneDesc, text: &str, assets: &AssetPath) -> Result<Scene, 
     // The same text parsed to a spanned document: where each key and value
     // stands, for errors found after deserializing.
     let document = toml::de::DeTable::parse(text).map(|d| d.into_inner()).unwrap_or_default();
-    let checker = Checker { text, assets, document, files: RefCell::default(), mesh_bytes: Cell::new(0) };
+    let checker = Checker {
+        text,
+        assets,
+        document,
+        files: RefCell::default(),
+        mesh_bytes: Cell::new(0),
+        notes: RefCell::default(),
+    };
     let mut scene = checker.scene(desc)?;
     scene.files = checker.files.into_inner();
+    scene.notes = checker.notes.into_inner();
     Ok(scene)
 }
 
@@ -60,6 +69,8 @@ pub(super) struct Checker<'a> {
     pub(super) files: RefCell<Vec<PathBuf>>,
     /// Memory the meshes read so far will take.
     pub(super) mesh_bytes: Cell<u64>,
+    /// What was asked for and is not done (see [`Scene::notes`]).
+    pub(super) notes: RefCell<Vec<String>>,
 }
 
 pub(super) type Result<T, E = SceneError> = std::result::Result<T, E>;
@@ -87,8 +98,26 @@ impl Checker<'_> {
     }
 
     fn scene(&self, desc: &SceneDesc) -> Result<Scene> {
-        let settings = self.settings(desc)?;
+        let mut settings = self.settings(desc)?;
+        let mut included = Vec::new();
+        for (i, include) in desc.include.iter().enumerate() {
+            included.push(self.include(i, include, desc)?);
+        }
+        // An included camera serves when the file has none; its aspect
+        // ratio sets the height when the file sets no size.
+        let included_camera = included.iter_mut().find_map(|i| i.camera.take()).filter(|_| desc.camera.is_none());
+        if let Some((_, Some(aspect))) = included_camera
+            && desc.render.width.is_none()
+            && desc.render.height.is_none()
+            && aspect.is_finite()
+            && aspect > 0.0
+        {
+            settings.height = ((settings.width as f32 / aspect).round() as u32).clamp(1, MAX_IMAGE_SIDE);
+        }
         let mut builder = SceneBuilder::new().settings(settings);
+        if let Some((camera, _)) = included_camera {
+            builder = builder.camera(camera);
+        }
         if let Some(camera) = &desc.camera {
             builder = builder.camera(self.camera(camera)?);
         }
@@ -100,6 +129,12 @@ impl Checker<'_> {
         }
         for (i, object) in desc.objects.iter().enumerate() {
             let built = self.object(i, object, desc)?;
+            builder = built.materials.into_iter().fold(builder, |b, (name, m)| b.material(&name, m));
+            builder = built.objects.into_iter().fold(builder, |b, (shape, name)| b.object(shape, &name));
+            builder = built.lights.into_iter().fold(builder, SceneBuilder::light);
+        }
+        for imported in included {
+            let built = imported.built;
             builder = built.materials.into_iter().fold(builder, |b, (name, m)| b.material(&name, m));
             builder = built.objects.into_iter().fold(builder, |b, (shape, name)| b.object(shape, &name));
             builder = built.lights.into_iter().fold(builder, SceneBuilder::light);
@@ -398,6 +433,52 @@ impl Checker<'_> {
         };
         let objects = vec![(self.placed(span, &label, shape.transformed(transform))?, material)];
         Ok(Built { objects, ..Built::default() })
+    }
+
+    /// One `[[include]]`: a glTF file, or an OBJ file as a mesh object
+    /// would take it.
+    fn include(&self, index: usize, desc: &Spanned<IncludeDesc>, scene: &SceneDesc) -> Result<gltf::Imported> {
+        let span = desc.span();
+        let d = desc.get_ref();
+        let label = format!("include[{index}]");
+        let transform = self.transform_parts(span.clone(), &label, d.translate, d.rotate, d.scale)?;
+        if let Some(name) = &d.material
+            && !scene.materials.contains_key(name.get_ref())
+        {
+            let known: Vec<&str> = scene.materials.keys().map(String::as_str).collect();
+            return Err(self.err(
+                name.span(),
+                format!("{label}: unknown material `{}`; the scene defines: {}", name.get_ref(), list(&known)),
+            ));
+        }
+        let material = d.material.as_ref().map(|m| m.get_ref().as_str());
+        let file = d.file.get_ref().to_ascii_lowercase();
+        if file.ends_with(".obj") {
+            if d.scene.is_some() {
+                return Err(self.err_field(span, "scene", format!("{label}: `scene` is for glTF files")));
+            }
+            let built = match material {
+                Some(name) => {
+                    let shape = self.placed(span, &label, self.mesh(&label, &d.file)?.transformed(transform))?;
+                    Built { objects: vec![(shape, name.to_string())], ..Built::default() }
+                }
+                None => self.mesh_with_materials(span, &label, &d.file, transform)?,
+            };
+            return Ok(gltf::Imported { built, camera: None, textures_skipped: 0 });
+        }
+        if !(file.ends_with(".gltf") || file.ends_with(".glb")) {
+            return Err(self.err(d.file.span(), format!("{label}: `file` must be a .gltf, .glb or .obj file")));
+        }
+        let imported =
+            self.gltf(&gltf::Include { label: &label, file: &d.file, scene: d.scene.as_deref(), transform, material })?;
+        if imported.textures_skipped > 0 {
+            self.notes.borrow_mut().push(format!(
+                "{label}: {} primitives have a base-colour texture, which Airlight does not read yet; \
+                 they take their base colour factor",
+                imported.textures_skipped
+            ));
+        }
+        Ok(imported)
     }
 
     /// A mesh object without a `material`: its faces take the `.mtl`

@@ -14,6 +14,7 @@ mod build_camera;
 mod build_lights;
 pub mod desc;
 mod error;
+mod gltf;
 mod lights;
 pub mod limits;
 mod mesh;
@@ -153,6 +154,8 @@ pub struct Scene {
     light_culling: LightCulling,
     /// The files the scene was read from (see [`Scene::files`]).
     pub(crate) files: Vec<std::path::PathBuf>,
+    /// What the scene file asked for that Airlight does not do (yet).
+    pub(crate) notes: Vec<String>,
 }
 
 impl Scene {
@@ -161,6 +164,12 @@ impl Scene {
     /// in code). Outputs must not replace them.
     pub fn files(&self) -> &[std::path::PathBuf] {
         &self.files
+    }
+
+    /// What the scene file asked for that Airlight does not do yet (a
+    /// glTF texture, for one), for the user to be told.
+    pub fn notes(&self) -> &[String] {
+        &self.notes
     }
 
     pub fn settings(&self) -> &RenderSettings {
@@ -526,6 +535,7 @@ impl SceneBuilder {
             bounds_radius: 1.0,
             light_culling,
             files: Vec::new(),
+            notes: Vec::new(),
         };
         scene.geometry = build_geometry(scene.surfaces());
         scene.update_bounds();
