@@ -287,7 +287,8 @@ error ∝ time^−½ (marked ~). Above 1 the method is faster than path tracing 
 <li><b>Time budget</b>: the truths may take half of it (single scattering first, then full transport with \
 what is left of that half); what is left is shared evenly by the series still to run, \
 each taking over what earlier ones left. A series stops before a pass that would not fit in its share (a pass costs \
-about as much as all before it); its first pass always runs. No pass runs past the budget's end.</li>\
+about as much as all before it); its first pass always runs, unless a probe (one sample of 16 pixels) finds \
+that it would end past the budget. A pass under way at the budget's end is cancelled as its tiles finish, and lost.</li>\
 <li>A series whose first image is the same, bit for bit, as an earlier one's is not continued (listed above).</li>\
 </ul>"
     );

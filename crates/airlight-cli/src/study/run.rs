@@ -8,7 +8,7 @@ use airlight::integrator::Integrator;
 use airlight::render::{Progressive, RenderObserver};
 use airlight::scene::Scene;
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 /// Why a run stopped.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -25,6 +25,9 @@ pub enum Stop {
     User,
     /// The study saw no point in going on (the same image as another series).
     Caller,
+    /// A probe before the first pass found that it would end past the
+    /// deadline.
+    Probe,
 }
 
 impl Stop {
@@ -36,6 +39,7 @@ impl Stop {
             Stop::Deadline => "the time budget is spent",
             Stop::User => "stopped by Ctrl-C",
             Stop::Caller => "not continued",
+            Stop::Probe => "by a probe of a few pixels, its first pass would end past the time budget",
         }
     }
 }
@@ -46,10 +50,13 @@ pub struct Run<'a> {
     pub pool: &'a rayon::ThreadPool,
     /// Set by Ctrl-C.
     pub stop: &'a AtomicBool,
-    /// No pass runs past this: one under way is cancelled (and lost).
+    /// No pass runs past this: none starts that would end after it (by
+    /// the last pass's pace, or a probe before the first), and one under
+    /// way is cancelled as its tiles finish (and lost).
     pub deadline: Instant,
     /// Seconds this run may take, its build included; the first pass runs
-    /// whatever it costs (else the run would show nothing).
+    /// whatever it costs (else the run would show nothing), if it fits
+    /// before the deadline.
     pub share: f64,
     /// Seconds already spent building the integrator.
     pub built: f64,
@@ -68,6 +75,7 @@ pub fn passes(run: &Run, rung: &mut Rung) -> Result<Stop, String> {
     let mut seconds = run.built;
     // Seconds per sample per pixel of the last pass.
     let mut per_spp: Option<f64> = None;
+    let mut first = true;
     loop {
         if progressive.finished() {
             return Ok(Stop::Spp);
@@ -84,16 +92,27 @@ pub fn passes(run: &Run, rung: &mut Rung) -> Result<Stop, String> {
         if now >= run.deadline {
             return Ok(Stop::Deadline);
         }
-        if let Some(per_spp) = per_spp {
+        if first {
+            // A tile cannot be stopped half way, and one tile of a slow
+            // method may take minutes: a first pass that would end past
+            // the deadline is not started.
+            let Some(probed) = probe(run) else {
+                return Ok(Stop::User);
+            };
+            if Instant::now() + Duration::from_secs_f64(probed.min(1e9)) > run.deadline {
+                return Ok(Stop::Probe);
+            }
+        } else if let Some(per_spp) = per_spp {
             // Pass sizes double, so a pass costs about all before it.
             let predicted = per_spp * progressive.next_pass_size() as f64;
             if seconds + predicted > run.share {
                 return Ok(Stop::Share);
             }
-            if now + std::time::Duration::from_secs_f64(predicted.min(1e9)) > run.deadline {
+            if now + Duration::from_secs_f64(predicted.min(1e9)) > run.deadline {
                 return Ok(Stop::Deadline);
             }
         }
+        first = false;
         let cancel = AtomicBool::new(false);
         let tile_done = |_: u64| {
             if run.stop.load(Ordering::Relaxed) || Instant::now() >= run.deadline {
@@ -114,5 +133,110 @@ pub fn passes(run: &Run, rung: &mut Rung) -> Result<Stop, String> {
         if !rung(&progressive, seconds)? {
             return Ok(Stop::Caller);
         }
+    }
+}
+
+/// Pixels per side of the grid a probe times.
+const PROBE: u32 = 4;
+
+/// The seconds a first pass (one sample of every pixel) would take, by
+/// one sample of each of up to 16 pixels spread over the image, spread over
+/// the pool's threads; the probe ends early at the deadline. None on
+/// Ctrl-C.
+fn probe(run: &Run) -> Option<f64> {
+    let s = run.scene.settings();
+    let start = Instant::now();
+    let mut samples = 0;
+    for i in 0..PROBE * PROBE {
+        if run.stop.load(Ordering::Relaxed) {
+            return None;
+        }
+        let (x, y) = ((2 * (i % PROBE) + 1) * s.width / (2 * PROBE), (2 * (i / PROBE) + 1) * s.height / (2 * PROBE));
+        airlight::render::pixel_sum(run.scene, run.integrator, x, y, 0..1);
+        samples += 1;
+        if Instant::now() >= run.deadline {
+            break;
+        }
+    }
+    let per_sample = start.elapsed().as_secs_f64() / samples as f64;
+    let pixels = s.width as f64 * s.height as f64;
+    Some(per_sample * pixels / run.pool.current_num_threads().max(1) as f64)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use airlight::geometry::Ray;
+    use airlight::prelude::*;
+    use airlight::sampling::Sampler;
+
+    /// Black, and `per_sample` of sleep for each sample: a slow method.
+    struct Slow {
+        per_sample: Duration,
+    }
+
+    impl Integrator for Slow {
+        fn radiance(&self, _: &Scene, _: &Ray, _: &mut Sampler) -> Rgb {
+            std::thread::sleep(self.per_sample);
+            Rgb::ZERO
+        }
+    }
+
+    fn scene() -> Scene {
+        SceneBuilder::new()
+            .size(32, 32)
+            .camera(Camera::look_at(vec3(0.0, 1.0, -5.0), vec3(0.0, 1.0, 0.0), Vec3::Y, 40.0))
+            .light(Light::point(vec3(0.0, 4.0, -2.0), Rgb::splat(20.0)))
+            .build()
+            .unwrap()
+    }
+
+    /// Runs `integrator` with `seconds` left before the deadline: the stop,
+    /// the rungs it made and how long it took.
+    fn run_with(integrator: &dyn Integrator, seconds: f64) -> (Stop, u32, Duration) {
+        let scene = scene();
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(2).build().unwrap();
+        let stop = AtomicBool::new(false);
+        let start = Instant::now();
+        let run = Run {
+            scene: &scene,
+            integrator,
+            pool: &pool,
+            stop: &stop,
+            deadline: start + Duration::from_secs_f64(seconds),
+            share: seconds,
+            built: 0.0,
+            target_error: None,
+            tick: &|| {},
+        };
+        let mut rungs = 0;
+        let stopped = passes(&run, &mut |_, _| {
+            rungs += 1;
+            Ok(true)
+        })
+        .unwrap();
+        (stopped, rungs, start.elapsed())
+    }
+
+    #[test]
+    fn a_first_pass_that_would_end_past_the_deadline_is_not_started() {
+        // A 16×16 tile of 5 ms samples takes 1.3 s on its thread, and the
+        // whole first pass 2.6 s on two: a pass started with 0.3 s left would
+        // only be cancelled as its first tiles finish, a second late.
+        let slow = Slow { per_sample: Duration::from_millis(5) };
+        let (stop, rungs, took) = run_with(&slow, 0.3);
+        assert_eq!((stop, rungs), (Stop::Probe, 0));
+        assert!(took < Duration::from_millis(800), "{took:?}");
+    }
+
+    #[test]
+    fn a_first_pass_that_fits_runs() {
+        // 1 ms samples: a pass of 1 spp takes about 0.5 s on two threads,
+        // which fits in 0.8 s (on one thread it would not); the second
+        // would not fit in the share.
+        let slow = Slow { per_sample: Duration::from_millis(1) };
+        let (stop, rungs, took) = run_with(&slow, 0.8);
+        assert_eq!((stop, rungs), (Stop::Share, 1));
+        assert!(took < Duration::from_millis(1500), "{took:?}");
     }
 }

@@ -94,9 +94,11 @@ pub fn truths(
         match (last, stop) {
             (_, Stop::User) => return Err("stopped by Ctrl-C while rendering the truth".into()),
             (None, _) => {
-                return Err("the time budget ran out before the truth's first pass: give a larger --time-budget \
-                            or a smaller --width/--height"
-                    .into());
+                return Err(format!(
+                    "the truth's first pass did not fit in the time budget ({}): give a larger --time-budget \
+                     or a smaller --width/--height",
+                    stop.describe()
+                ));
             }
             (Some(image), _) => images.push((transport, image)),
         }
@@ -193,6 +195,7 @@ pub fn ladder(
                 "the same image as {} at 1 spp, bit for bit: not continued",
                 firsts.iter().find(|(_, f)| *f == firsts[firsts.len() - 1].1).map_or("another", |(l, _)| l)
             )),
+            (Stop::Probe, true) => Some(format!("not started: {}", stop.describe())),
             (_, true) => Some(format!("no pass finished: {}", stop.describe())),
             _ => None,
         };
