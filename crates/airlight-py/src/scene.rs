@@ -1,0 +1,359 @@
+//! `airlight.Scene`: a scene read from a file, text or dicts, rendered into
+//! NumPy arrays.
+//!
+//! Scenes made from one another by `at_time` or `frame` share the Rust scene
+//! and the integrator last built for it, as the CLI's animations do: the
+//! integrator is built once for the lights as the file writes them, and a
+//! render at another time only moves the lights and tells the integrator
+//! (radiosity relights instead of recompiling). So two renders of such
+//! scenes take turns.
+
+use crate::errors::{Origin, guard, scene_error};
+use crate::options::{self, Film};
+use crate::render::{self, Job, Output, Progress};
+use airlight::SceneFile;
+use airlight::integrator::{Integrator, IntegratorDesc, IntegratorError};
+use airlight::light::Light;
+use airlight::scene::{RenderSettings, Scene};
+use numpy::PyArray3;
+use numpy::ndarray::Array3;
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use std::path::PathBuf;
+use std::sync::{Arc, Mutex};
+
+/// Where the lights are: None as the file writes them (a still render),
+/// Some(t) at time t of the keyframes.
+pub type Pose = Option<f32>;
+
+/// The Rust scene and its integrator, shared by the scenes `at_time` makes.
+pub struct Shared {
+    pub scene: Scene,
+    /// The lights as the file writes them.
+    base_lights: Vec<Light>,
+    /// The pose the scene's lights are in; None while unknown (a panic
+    /// part way through moving them).
+    pose: Option<Pose>,
+    cache: Option<Cached>,
+}
+
+/// The integrator last built, what it was built from, and the pose it was
+/// last told of (None: unknown).
+struct Cached {
+    desc: IntegratorDesc,
+    /// Radiosity draws its patches' samples with the scene's seed.
+    seed: u64,
+    integrator: Box<dyn Integrator>,
+    pose: Option<Pose>,
+}
+
+impl Shared {
+    fn new(scene: Scene) -> Shared {
+        Shared { base_lights: scene.lights().to_vec(), scene, pose: Some(None), cache: None }
+    }
+
+    /// After a panic while the scene was held: rebuild what it changed.
+    pub fn forget(&mut self) {
+        self.pose = None;
+        self.cache = None;
+    }
+
+    /// Brings the lights to `pose` and the integrator `desc` to them,
+    /// building it if the cached one is of another description or seed.
+    pub fn prepare(&mut self, desc: IntegratorDesc, pose: Pose) -> Result<(), IntegratorError> {
+        let seed = self.scene.settings().seed;
+        if !matches!(&self.cache, Some(c) if c.desc == desc && c.seed == seed) {
+            self.cache = None;
+            // As `airlight render --frames` does: built for the file's
+            // lights, then moved to the frame.
+            self.move_lights(None);
+            let integrator = desc.build(&self.scene)?;
+            self.cache = Some(Cached { desc, seed, integrator, pose: Some(None) });
+        }
+        self.move_lights(pose);
+        let Some(cached) = self.cache.as_mut() else { unreachable!("built above") };
+        if cached.pose != Some(pose) {
+            cached.pose = None;
+            cached.integrator.lights_changed(&self.scene)?;
+            cached.pose = Some(pose);
+        }
+        Ok(())
+    }
+
+    fn move_lights(&mut self, pose: Pose) {
+        if self.pose == Some(pose) {
+            return;
+        }
+        self.pose = None;
+        // From the file's lights each time, so that a frame's lights do not
+        // depend on the frames rendered before it.
+        self.scene.set_lights(&self.base_lights);
+        if let Some(t) = pose {
+            self.scene.at_time(t);
+        }
+        self.pose = Some(pose);
+    }
+
+    /// The integrator [`Shared::prepare`] made ready.
+    pub fn integrator(&self) -> &dyn Integrator {
+        match &self.cache {
+            Some(c) => c.integrator.as_ref(),
+            None => unreachable!("prepare() builds the integrator before a render"),
+        }
+    }
+}
+
+/// A scene's text and where it came from, for `with_lights` and errors.
+pub struct Source {
+    pub text: String,
+    /// Where relative mesh paths start.
+    pub base_dir: Option<PathBuf>,
+    pub origin: Origin,
+    /// The file, for error messages.
+    pub file: Option<PathBuf>,
+}
+
+/// What a scene holds, read once.
+struct Summary {
+    animated: bool,
+    lights: usize,
+    medium: bool,
+}
+
+/// A scene ready to render: read from a scene file (`airlight.load`), TOML
+/// text (`airlight.loads`) or dicts with the file's keys (`airlight.Scene(d)`).
+#[pyclass(name = "Scene", module = "airlight", frozen)]
+pub struct PyScene {
+    shared: Arc<Mutex<Shared>>,
+    source: Arc<Source>,
+    summary: Arc<Summary>,
+    settings: RenderSettings,
+    integrator: IntegratorDesc,
+    time: Option<f32>,
+}
+
+/// Reads a scene; the GIL is released meanwhile (meshes may be large).
+pub fn read(py: Python<'_>, source: Source) -> PyResult<PyScene> {
+    let parsed = py.detach(|| {
+        SceneFile::from_toml_str(&source.text, source.base_dir.as_deref()).map_err(|e| match &source.file {
+            Some(file) => e.in_file(file),
+            None => e,
+        })
+    });
+    let SceneFile { scene, integrator } = parsed.map_err(|e| scene_error(py, &e, &source.origin, &source.text))?;
+    let summary =
+        Summary { animated: scene.is_animated(), lights: scene.lights().len(), medium: scene.medium().is_some() };
+    Ok(PyScene {
+        settings: scene.settings().clone(),
+        integrator,
+        shared: Arc::new(Mutex::new(Shared::new(scene))),
+        source: Arc::new(source),
+        summary: Arc::new(summary),
+        time: None,
+    })
+}
+
+/// A scene from dicts: written as TOML and read as a file would be.
+pub fn from_dict(py: Python<'_>, scene: &Bound<'_, PyAny>, base_dir: Option<PathBuf>) -> PyResult<PyScene> {
+    let table = crate::dict::table(scene, "scene")?;
+    let text =
+        toml::to_string(&table).map_err(|e| PyValueError::new_err(format!("cannot write the scene as TOML: {e}")))?;
+    read(py, Source { text, base_dir, origin: Origin::Dict, file: None })
+}
+
+impl PyScene {
+    fn at(&self, time: Option<f32>) -> PyScene {
+        PyScene {
+            shared: Arc::clone(&self.shared),
+            source: Arc::clone(&self.source),
+            summary: Arc::clone(&self.summary),
+            settings: self.settings.clone(),
+            integrator: self.integrator,
+            time,
+        }
+    }
+}
+
+/// A buffer of H·W RGB triples as an (H, W, 3) array; NumPy takes the
+/// buffer over, nothing is copied.
+fn array(py: Python<'_>, pixels: Vec<f32>, w: u32, h: u32) -> PyResult<Bound<'_, PyArray3<f32>>> {
+    let a = Array3::from_shape_vec((h as usize, w as usize, 3), pixels)
+        .map_err(|e| crate::errors::internal_error(&format!("image buffer: {e}")))?;
+    Ok(PyArray3::from_owned_array(py, a))
+}
+
+#[pymethods]
+impl PyScene {
+    /// A scene from dicts with the scene file's keys (`render`, `camera`,
+    /// `materials`, `objects`, `lights`, `medium`), checked as a file is;
+    /// relative mesh paths start at `base_dir` (default: the current one).
+    #[new]
+    #[pyo3(signature = (scene, base_dir=None))]
+    fn new(py: Python<'_>, scene: &Bound<'_, PyAny>, base_dir: Option<PathBuf>) -> PyResult<PyScene> {
+        guard(|| from_dict(py, scene, base_dir))
+    }
+
+    /// Image width in pixels (the file's; `render(width=...)` overrides it).
+    #[getter]
+    fn width(&self) -> u32 {
+        self.settings.width
+    }
+
+    #[getter]
+    fn height(&self) -> u32 {
+        self.settings.height
+    }
+
+    /// Samples per pixel the file asks for.
+    #[getter]
+    fn spp(&self) -> u32 {
+        self.settings.spp
+    }
+
+    #[getter]
+    fn seed(&self) -> u64 {
+        self.settings.seed
+    }
+
+    /// The integrator the file names (or its default).
+    #[getter]
+    fn integrator(&self) -> &'static str {
+        self.integrator.kind.name()
+    }
+
+    /// The animation time this scene's lights are at, or None for the
+    /// lights as written.
+    #[getter]
+    fn time(&self) -> Option<f32> {
+        self.time
+    }
+
+    /// Whether any light has keyframes.
+    #[getter]
+    fn is_animated(&self) -> bool {
+        self.summary.animated
+    }
+
+    /// The scene as TOML text: the file read, or what a dict was written as.
+    #[getter]
+    fn toml(&self) -> &str {
+        &self.source.text
+    }
+
+    fn __repr__(&self) -> String {
+        let s = &self.settings;
+        let time = self.time.map(|t| format!(", time {t}")).unwrap_or_default();
+        format!(
+            "<airlight.Scene {}×{}, {} spp, {}, {} lights{}{time}>",
+            s.width,
+            s.height,
+            s.spp,
+            self.integrator.kind,
+            self.summary.lights,
+            if self.summary.medium { ", medium" } else { "" }
+        )
+    }
+
+    /// The scene with its keyframed lights at `time` in [0, 1] (held at the
+    /// end keys outside them); it shares this scene's integrator, so an
+    /// animation compiles radiosity once.
+    fn at_time(&self, time: f64) -> PyResult<PyScene> {
+        if !time.is_finite() {
+            return Err(PyValueError::new_err(format!("time must be a finite number, got {time}")));
+        }
+        Ok(self.at(Some(time as f32)))
+    }
+
+    /// Frame `k` of an `n`-frame animation, at time k/(n − 1) as
+    /// `airlight render --frames n --frame k` renders it.
+    fn frame(&self, k: u32, n: u32) -> PyResult<PyScene> {
+        if k >= n {
+            return Err(PyValueError::new_err(format!("frame {k}: the animation has frames 0 to {}", n as i64 - 1)));
+        }
+        Ok(self.at(Some(airlight::render::frame_time(k, n))))
+    }
+
+    /// The scene with other lights: a list of dicts as the file's
+    /// `[[lights]]` tables (keyframes too). The scene is read again from its
+    /// text with these lights, at the lights' written pose.
+    fn with_lights(&self, py: Python<'_>, lights: &Bound<'_, PyAny>) -> PyResult<PyScene> {
+        guard(|| {
+            let mut table: toml::Table = self
+                .source
+                .text
+                .parse()
+                .map_err(|e| crate::errors::internal_error(&format!("the scene's own text: {e}")))?;
+            table.insert("lights".into(), crate::dict::array(lights, "lights")?);
+            let text = toml::to_string(&table)
+                .map_err(|e| PyValueError::new_err(format!("cannot write the scene as TOML: {e}")))?;
+            let base_dir = self.source.base_dir.clone();
+            read(py, Source { text, base_dir, origin: Origin::Dict, file: None })
+        })
+    }
+
+    /// Renders the scene; returns linear RGB as a float32 array (height,
+    /// width, 3), or with `aovs=True` a dict of named arrays: `color` and
+    /// `variance` (the estimated variance of each pixel's mean, per channel).
+    /// See the type stubs for every argument.
+    #[pyo3(signature = (
+        integrator=None, *, spp=None, seed=None, width=None, height=None, threads=None,
+        shard=None, progress=None, aovs=false, **options
+    ))]
+    #[allow(clippy::too_many_arguments)]
+    fn render<'py>(
+        &self,
+        py: Python<'py>,
+        integrator: Option<&Bound<'py, PyAny>>,
+        spp: Option<&Bound<'py, PyAny>>,
+        seed: Option<&Bound<'py, PyAny>>,
+        width: Option<&Bound<'py, PyAny>>,
+        height: Option<&Bound<'py, PyAny>>,
+        threads: Option<i64>,
+        shard: Option<(i64, i64)>,
+        progress: Option<&Bound<'py, PyAny>>,
+        aovs: bool,
+        options: Option<&Bound<'py, PyDict>>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        guard(|| {
+            let settings = Film { spp, seed, width, height }.apply(&self.settings)?;
+            let desc = options::integrator(self.integrator, integrator, options)?;
+            let threads = match threads {
+                None => 0,
+                Some(n) if n >= 1 => n as usize,
+                Some(n) => return Err(PyValueError::new_err(format!("threads must be at least 1, got {n}"))),
+            };
+            let spp = settings.spp as u64;
+            let samples = match shard {
+                None => 0..spp,
+                Some((k, n)) if !(0 <= k && k < n) => {
+                    return Err(PyValueError::new_err(format!("shard (k, n) needs 0 ≤ k < n, got ({k}, {n})")));
+                }
+                Some((_, n)) if n as u64 > spp => {
+                    return Err(PyValueError::new_err(format!(
+                        "shard (k, {n}): the render has only {spp} samples per pixel, so at most {spp} shards"
+                    )));
+                }
+                Some((k, n)) => airlight::film::partial::piece(spp, k as u64, n as u64),
+            };
+            let label =
+                format!("{} {}×{} {} spp", desc.kind, settings.width, settings.height, samples.end - samples.start);
+            let progress = Progress::from_arg(py, progress, &label)?;
+            let (w, h) = (settings.width, settings.height);
+            // A scene without keyframes is the same at every time.
+            let pose = self.time.filter(|_| self.summary.animated);
+            let job = Job { shared: Arc::clone(&self.shared), settings, desc, pose, samples, threads, variance: aovs };
+            let Output { color, variance } = render::run(py, job, progress)?;
+            let color = array(py, color, w, h)?;
+            if !aovs {
+                return Ok(color.into_any());
+            }
+            let out = PyDict::new(py);
+            out.set_item("color", color)?;
+            if let Some(v) = variance {
+                out.set_item("variance", array(py, v, w, h)?)?;
+            }
+            Ok(out.into_any())
+        })
+    }
+}
