@@ -3,13 +3,17 @@
 use airlight::SceneFile;
 use airlight::film::{self, Image};
 use airlight::integrator::IntegratorKind;
+use airlight::integrator::MAX_BOUNCES;
 use airlight::render::RenderObserver;
+use airlight::scene::{MAX_IMAGE_SIDE, MAX_SPP};
 use clap::{Parser, Subcommand};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 mod merge;
+mod outputs;
 mod plot;
+mod preflight;
 mod progress;
 mod render;
 mod submit;
@@ -89,7 +93,7 @@ struct GiArgs {
     /// Scene file (TOML).
     scene: PathBuf,
     /// Frames; frame k is at time k/(frames − 1) of the animation.
-    #[arg(long, default_value_t = 60, value_parser = clap::value_parser!(u32).range(1..))]
+    #[arg(long, default_value_t = 60, value_parser = clap::value_parser!(u32).range(1..=preflight::MAX_FRAMES as i64))]
     frames: u32,
     /// Write every frame, rendered with the radiosity integrator, as
     /// DIR/frame_0000.png, … (not timed).
@@ -99,24 +103,29 @@ struct GiArgs {
     #[arg(long)]
     patch_size: Option<f32>,
     /// Bounces (overrides render.bounces).
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=MAX_BOUNCES as i64))]
     bounces: Option<u32>,
     /// Link threshold (overrides render.link_threshold).
     #[arg(long)]
     link_threshold: Option<f32>,
     /// Samples per pixel of written frames.
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=MAX_SPP as i64))]
     spp: Option<u32>,
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=MAX_IMAGE_SIDE as i64))]
     width: Option<u32>,
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=MAX_IMAGE_SIDE as i64))]
     height: Option<u32>,
     /// Worker threads (default: all cores).
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=crate::preflight::MAX_THREADS as i64))]
     threads: Option<u32>,
 }
 
 fn main() -> ExitCode {
+    // Die quietly of SIGPIPE, as command-line tools do, when the reader of
+    // our output goes away (`airlight info s.toml | head -1`); Rust ignores
+    // it, which turns every later print into a panic.
+    // SAFETY: setting a signal's disposition to the default, before any thread starts.
+    unsafe { libc::signal(libc::SIGPIPE, libc::SIG_DFL) };
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Render(args) => render::render(args),
@@ -140,7 +149,7 @@ fn main() -> ExitCode {
 /// The scene file at `path`, or the built-in demo scene.
 fn load(path: Option<&Path>) -> Result<SceneFile, String> {
     match path {
-        Some(path) => SceneFile::load(path).map_err(|e| e.to_string()),
+        Some(path) => SceneFile::load_with(path, &airlight::scene::AssetPath::from_env()).map_err(|e| e.to_string()),
         None => SceneFile::from_toml_str(DEMO_SCENE, None).map_err(|e| format!("built-in demo scene: {e}")),
     }
 }
@@ -172,8 +181,10 @@ fn gi(args: GiArgs) -> Result<(), String> {
     }
     s.validate()?;
     if let Some(dir) = &args.output_dir {
-        std::fs::create_dir_all(dir).map_err(|e| format!("cannot create `{}`: {e}", dir.display()))?;
+        outputs::check_folder("--output-dir", dir)?;
+        preflight::render_memory(&scene, false)?;
     }
+    preflight::warn_if_dark(&scene, true);
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(args.threads.unwrap_or(0) as usize)
         .build()
@@ -210,7 +221,11 @@ fn gi(args: GiArgs) -> Result<(), String> {
             ms(st.link)
         );
         let mut frames = Vec::with_capacity(args.frames as usize);
+        let forecast = preflight::Forecast::new(args.frames as u64, format!("{} frames", args.frames), false);
         for k in 0..args.frames {
+            if let Some(warning) = forecast.advance(1) {
+                eprintln!("{warning}");
+            }
             set_time(&mut scene, &mut integrator, frame_time(k, args.frames)).map_err(|e| e.to_string())?;
             frames.push(integrator.last_update);
             if let Some(dir) = &args.output_dir {
@@ -243,6 +258,7 @@ fn gi(args: GiArgs) -> Result<(), String> {
 
 fn info(path: &Path) -> Result<(), String> {
     let SceneFile { scene, integrator } = load(Some(path))?;
+    preflight::warn_if_dark(&scene, integrator.kind != IntegratorKind::Direct);
     let s = scene.settings();
     println!("scene: {}", path.display());
     println!("image: {}×{}, {} spp, integrator {}", s.width, s.height, s.spp, integrator.kind);
@@ -271,6 +287,11 @@ fn info(path: &Path) -> Result<(), String> {
 fn compare(a: &Path, b: &Path, map: Option<&Path>) -> Result<(), String> {
     let image = Image::read_exr(a).map_err(|e| format!("cannot read `{}`: {e}", a.display()))?;
     let reference = Image::read_exr(b).map_err(|e| format!("cannot read `{}`: {e}", b.display()))?;
+    if let Some(map) = map {
+        outputs::check(&[outputs::Output { option: "--map", path: map }], &[a, b])?;
+    }
+    preflight::finite_pixels(&image, a)?;
+    preflight::finite_pixels(&reference, b)?;
     let e = film::compare(&image, &reference).ok_or_else(|| {
         format!(
             "the images differ in size: {}×{} and {}×{}",
@@ -298,8 +319,16 @@ fn attenuation(args: AttenuationArgs) -> Result<(), String> {
     let positive = |v: f32, name: &str| {
         if v.is_finite() && v > 0.0 { Ok(v) } else { Err(format!("--{name} must be a positive number, got {v}")) }
     };
+    outputs::check(&[outputs::Output { option: "-o", path: &args.output }], &[])?;
     let r = positive(args.radius, "radius")?;
     let e0 = positive(args.intensity, "intensity")? / (r * r);
+    if !(e0.is_normal() && e0.is_finite()) {
+        return Err(format!(
+            "the irradiance at the light's surface, --intensity / --radius² = {:.3e}, is out of the range of 32-bit \
+             floats (about 1e-38 to 3e38)",
+            args.intensity as f64 / (r as f64 * r as f64)
+        ));
+    }
     let cutoff = positive(args.cutoff, "cutoff")?;
     let range = args.range.map(|d| positive(d, "range")).transpose()?;
     if cutoff >= e0 {
@@ -320,6 +349,13 @@ fn attenuation(args: AttenuationArgs) -> Result<(), String> {
     }
     println!("sphere: same curve as physical (1/(d/r + 1)^2), d_max = inf");
     let finite = curves.iter().map(|(a, ..)| a.range).filter(|d| d.is_finite()).fold(0.0, f32::max);
+    if finite <= 0.0 {
+        return Err(format!(
+            "no curve reaches zero at a finite distance: I/r² / --cutoff = {:.3e} overflows 32-bit floats; \
+             give a larger --cutoff, or a --range",
+            e0 as f64 / cutoff as f64
+        ));
+    }
     let x_max = 1.15 * finite;
     let series = curves
         .iter()
@@ -339,6 +375,7 @@ fn attenuation(args: AttenuationArgs) -> Result<(), String> {
         log_y: true,
         series,
     };
-    plot.render().save(&args.output).map_err(|e| format!("cannot write `{}`: {e}", args.output.display()))?;
+    let image = plot.render().map_err(|e| format!("cannot plot these curves: {e}"))?;
+    image.save(&args.output).map_err(|e| format!("cannot write `{}`: {e}", args.output.display()))?;
     Ok(())
 }

@@ -79,20 +79,44 @@ fn text_width(s: &str) -> f32 {
     (s.chars().count() as u32 * 8 * TEXT) as f32
 }
 
-/// A tick spacing of 1, 2 or 5 times a power of ten giving about `count` ticks.
+/// A tick spacing of 1, 2 or 5 times a power of ten giving about `count`
+/// ticks; `max` positive and finite (else the spacing is `max` itself).
 fn tick_step(max: f32, count: f32) -> f32 {
     let raw = max / count;
-    let power = 10f32.powf(raw.log10().floor());
-    [1.0, 2.0, 5.0, 10.0].into_iter().map(|m| m * power).find(|s| *s >= raw).unwrap_or(10.0 * power)
+    if !(raw.is_normal() && raw > 0.0) {
+        return max;
+    }
+    // In f64: a power of ten near f32's ends (1e-40, 1e38) would round to 0 or ∞.
+    let power = 10f64.powf((raw as f64).log10().floor());
+    let step = [1.0, 2.0, 5.0, 10.0].into_iter().map(|m| m * power).find(|s| *s >= raw as f64).unwrap_or(10.0 * power);
+    step as f32
 }
 
+/// `v` with as many decimals as `step` needs; in scientific notation when
+/// that would be more than a few (spans of 1e-20, or beyond 1e6).
 fn label(v: f32, step: f32) -> String {
-    let decimals = (-step.log10().floor()).max(0.0) as usize;
+    let magnitude = step.abs().log10();
+    if !magnitude.is_finite() || !(-4.0..=6.0).contains(&magnitude) {
+        return format!("{v:.1e}");
+    }
+    let decimals = (-magnitude.floor()).max(0.0) as usize;
     format!("{v:.decimals$}")
 }
 
 impl Plot {
-    pub fn render(&self) -> Image {
+    /// The plot as an image; `x_max` and the y range must be finite and
+    /// non-empty (else nothing sensible can be drawn: an error says so).
+    pub fn render(&self) -> Result<Image, String> {
+        if !(self.x_max.is_finite() && self.x_max > 0.0) {
+            return Err(format!("the x axis must span a positive finite length, got 0 to {}", self.x_max));
+        }
+        if !(self.y_min.is_finite() && self.y_max.is_finite() && self.y_min < self.y_max) {
+            return Err(format!("the y axis must span a finite range, got {} to {}", self.y_min, self.y_max));
+        }
+        Ok(self.draw())
+    }
+
+    fn draw(&self) -> Image {
         let mut c = Canvas(Image { width: W, height: H, pixels: vec![Rgb::ONE; (W * H) as usize] });
         let (x0, x1, y0, y1) = (LEFT, W as f32 - RIGHT, H as f32 - BOTTOM, TOP);
         let to_px = |x: f32, y: f32| {
@@ -105,7 +129,10 @@ impl Plot {
             let log = !vertical && self.log_y;
             let step = if log { 1.0 } else { tick_step(axis_max - axis_min, 6.0) };
             let mut v = axis_min;
-            while v <= axis_max + (axis_max - axis_min) * 1e-4 {
+            // At most a few dozen ticks, whatever rounding does to the steps.
+            let mut ticks = 0;
+            while v <= axis_max + (axis_max - axis_min) * 1e-4 && ticks < 40 {
+                ticks += 1;
                 if vertical {
                     let (px, _) = to_px(v, 0.0);
                     c.line((px, y0), (px, y1), grey, 1);
@@ -155,6 +182,12 @@ mod tests {
         assert_eq!(tick_step(37.0, 6.0), 10.0);
         assert_eq!(label(0.4, 0.2), "0.4");
         assert_eq!(label(20.0, 10.0), "20");
+        // Spans near f32's ends (attenuation --radius 1e-20, --cutoff 1e-45).
+        assert_eq!(tick_step(1e-20, 6.0), 2e-21);
+        assert_eq!(tick_step(3e38, 6.0), 5e37);
+        assert_eq!(tick_step(0.0, 6.0), 0.0);
+        assert_eq!(label(2e-21, 2e-21), "2.0e-21");
+        assert_eq!(label(1e23, 2e22), "1.0e23");
     }
 
     #[test]
@@ -170,7 +203,7 @@ mod tests {
             log_y: false,
             series: vec![Series { label: "line".into(), color: red, points: vec![(0.0, 0.5), (1.0, 0.5)] }],
         };
-        let img = plot.render();
+        let img = plot.render().unwrap();
         // The middle of the plot area at y = 0.5 is red.
         let (x, y) = ((LEFT + (W as f32 - RIGHT)) / 2.0, ((H as f32 - BOTTOM) + TOP) / 2.0);
         assert_eq!(img.pixel(x as u32, y as u32), red);

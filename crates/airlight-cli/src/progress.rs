@@ -2,6 +2,7 @@
 //! is a file or a pipe (a render farm's log), at most one every few
 //! seconds, with the percentage, the samples per second and the time left.
 
+use crate::preflight::Forecast;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::io::IsTerminal;
 use std::sync::Mutex;
@@ -12,7 +13,14 @@ use std::time::{Duration, Instant};
 /// changes it.
 const DEFAULT_INTERVAL: f64 = 5.0;
 
-pub enum Progress {
+/// A run's progress: how it is shown, and the forecast that warns (once)
+/// when the run looks endless.
+pub struct Progress {
+    display: Display,
+    forecast: Option<Forecast>,
+}
+
+enum Display {
     Hidden,
     Bar(ProgressBar),
     Lines(Lines),
@@ -30,8 +38,46 @@ pub struct Lines {
 impl Progress {
     /// Progress over `total` units (pixel samples). Nothing with `quiet`.
     pub fn new(total: u64, quiet: bool) -> Progress {
+        Progress { display: Display::new(total, quiet), forecast: None }
+    }
+
+    /// The same, also warning when `forecast` projects an endless run.
+    pub fn with_forecast(mut self, forecast: Forecast) -> Progress {
+        self.forecast = Some(forecast);
+        self
+    }
+
+    /// `n` more units done (from any thread).
+    pub fn inc(&self, n: u64) {
+        self.display.inc(n);
+        if let Some(warning) = self.forecast.as_ref().and_then(|f| f.advance(n)) {
+            self.println(&warning);
+        }
+    }
+
+    pub fn set_message(&self, message: String) {
+        self.display.set_message(message)
+    }
+
+    /// Prints a line of its own, above a bar.
+    pub fn println(&self, line: &str) {
+        match &self.display {
+            Display::Bar(bar) => bar.suspend(|| eprintln!("{line}")),
+            _ => eprintln!("{line}"),
+        }
+    }
+
+    pub fn finish(&self) {
+        if let Display::Bar(bar) = &self.display {
+            bar.finish_and_clear();
+        }
+    }
+}
+
+impl Display {
+    fn new(total: u64, quiet: bool) -> Display {
         if quiet {
-            return Progress::Hidden;
+            return Display::Hidden;
         }
         if std::io::stderr().is_terminal() {
             let bar = ProgressBar::with_draw_target(Some(total), ProgressDrawTarget::stderr());
@@ -40,7 +86,7 @@ impl Progress {
             {
                 bar.set_style(style.progress_chars("=> "));
             }
-            return Progress::Bar(bar);
+            return Display::Bar(bar);
         }
         let seconds = std::env::var("AIRLIGHT_PROGRESS_SECONDS")
             .ok()
@@ -48,7 +94,7 @@ impl Progress {
             .filter(|s| s.is_finite() && *s >= 0.0)
             .unwrap_or(DEFAULT_INTERVAL);
         let start = Instant::now();
-        Progress::Lines(Lines {
+        Display::Lines(Lines {
             total: total.max(1),
             done: AtomicU64::new(0),
             start,
@@ -57,12 +103,11 @@ impl Progress {
         })
     }
 
-    /// `n` more units done (from any thread).
-    pub fn inc(&self, n: u64) {
+    fn inc(&self, n: u64) {
         match self {
-            Progress::Hidden => {}
-            Progress::Bar(bar) => bar.inc(n),
-            Progress::Lines(lines) => {
+            Display::Hidden => {}
+            Display::Bar(bar) => bar.inc(n),
+            Display::Lines(lines) => {
                 let done = lines.done.fetch_add(n, Ordering::Relaxed) + n;
                 // Another thread printing: this one skips its line.
                 if let Ok(mut state) = lines.state.try_lock()
@@ -75,29 +120,15 @@ impl Progress {
         }
     }
 
-    pub fn set_message(&self, message: String) {
+    fn set_message(&self, message: String) {
         match self {
-            Progress::Hidden => {}
-            Progress::Bar(bar) => bar.set_message(message),
-            Progress::Lines(lines) => {
+            Display::Hidden => {}
+            Display::Bar(bar) => bar.set_message(message),
+            Display::Lines(lines) => {
                 if let Ok(mut state) = lines.state.lock() {
                     state.1 = message;
                 }
             }
-        }
-    }
-
-    /// Prints a line of its own, above a bar.
-    pub fn println(&self, line: &str) {
-        match self {
-            Progress::Bar(bar) => bar.suspend(|| eprintln!("{line}")),
-            _ => eprintln!("{line}"),
-        }
-    }
-
-    pub fn finish(&self) {
-        if let Progress::Bar(bar) = self {
-            bar.finish_and_clear();
         }
     }
 }

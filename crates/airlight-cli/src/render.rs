@@ -4,14 +4,15 @@
 //! to merge.
 
 use crate::load;
+use crate::preflight::Forecast;
 use crate::progress::Progress;
 use airlight::SceneFile;
 use airlight::film::Image;
 use airlight::film::partial::{Partial, PartialHeader, piece};
 use airlight::integrator::analytic::LightQuadrature;
-use airlight::integrator::{Integrator, IntegratorKind, Sampling};
+use airlight::integrator::{Integrator, IntegratorKind, MAX_LIGHT_STEPS, MAX_STEPS, Sampling};
 use airlight::render::{Progressive, RenderObserver, accumulate, frame_time, set_time};
-use airlight::scene::Scene;
+use airlight::scene::{MAX_IMAGE_SIDE, MAX_SPP, Scene};
 use std::ops::Range;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -52,7 +53,7 @@ pub struct RenderArgs {
     /// Render N frames of the scene's light animation (lights with
     /// keyframes), frame k at time k/(N − 1), each output numbered:
     /// NAME_0000.png, NAME_0001.png, ...
-    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..))]
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=crate::preflight::MAX_FRAMES as i64))]
     frames: Option<u32>,
     /// With --frames N: only frame K (0 ≤ K < N), named as --frames names it.
     #[arg(long, value_name = "K", requires = "frames")]
@@ -71,14 +72,14 @@ pub struct RenderArgs {
     #[arg(long, requires = "progressive")]
     resume: bool,
     /// Samples per pixel.
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=MAX_SPP as i64))]
     spp: Option<u32>,
     /// March samples per ray.
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=MAX_STEPS as i64))]
     steps: Option<u32>,
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=MAX_IMAGE_SIDE as i64))]
     width: Option<u32>,
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=MAX_IMAGE_SIDE as i64))]
     height: Option<u32>,
     #[arg(long)]
     seed: Option<u64>,
@@ -90,13 +91,13 @@ pub struct RenderArgs {
     #[arg(long)]
     shadows: bool,
     /// analytic: points per dimension over line and quad lights.
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=4096))]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=MAX_LIGHT_STEPS as i64))]
     light_steps: Option<u32>,
     /// analytic: gauss (Gauss–Legendre) or uniform (equal steps) over lights.
     #[arg(long, value_parser = parse_light_quadrature)]
     light_quadrature: Option<LightQuadrature>,
     /// Worker threads (default: all cores). The image does not depend on it.
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=crate::preflight::MAX_THREADS as i64))]
     threads: Option<u32>,
     /// No progress bar or summary.
     #[arg(long, short)]
@@ -189,16 +190,28 @@ pub fn render(args: RenderArgs) -> Result<(), String> {
     let (SceneFile { mut scene, integrator: desc }, plan, outputs) = prepare(&args)?;
     // Of the scene as resolved, before any frame moves its lights.
     let fingerprint = airlight::fingerprint(&scene, &desc);
+    let progressive = args.progressive || args.target_error.is_some() || args.variance.is_some();
+    let (files, variance) = (scene.files(), args.variance.as_deref());
+    crate::outputs::check_render(args.scene.as_deref(), files, &outputs, variance, args.frames)?;
+    crate::preflight::render_memory(&scene, progressive)?;
+    crate::preflight::warn_if_dark(&scene, desc.kind != IntegratorKind::Direct);
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(args.threads.unwrap_or(0) as usize)
         .build()
         .map_err(|e| format!("cannot start worker threads: {e}"))?;
-    let progressive = args.progressive || args.target_error.is_some() || args.variance.is_some();
-    let progress = Progress::new(plan.work(&scene), args.quiet);
     let start = Instant::now();
     // Built once: between frames the integrator only hears that the lights
     // moved (radiosity relights without recompiling).
     let mut integrator = pool.install(|| desc.build(&scene)).map_err(|e| e.to_string())?;
+    let what = describe(&scene, args.frames);
+    let frame_count = plan.frames.as_ref().map_or(1, |(list, _)| list.len() as u32);
+    let threads = pool.current_num_threads();
+    let probe = pool.install(|| crate::preflight::probe(&scene, integrator.as_ref(), threads, frame_count, &what));
+    if let Some(warning) = &probe {
+        eprintln!("{warning}");
+    }
+    let forecast = Forecast::new(plan.work(&scene), what, probe.is_some());
+    let progress = Progress::new(plan.work(&scene), args.quiet).with_forecast(forecast);
     let mut written = Vec::new();
     let frames: Vec<Option<(u32, u32)>> = match &plan.frames {
         Some((list, n)) => list.iter().map(|&k| Some((k, *n))).collect(),
@@ -483,6 +496,12 @@ fn render_progressive(
     let skipped = (s.spp - progressive.samples()) as u64 * s.width as u64 * s.height as u64;
     progress.inc(skipped);
     Ok(format!("{} spp, estimated relative error {}", progressive.samples(), format_error(error)))
+}
+/// "this render (N frames of W×H at S spp)", for the forecast.
+fn describe(scene: &Scene, frames: Option<u32>) -> String {
+    let s = scene.settings();
+    let frames = frames.map(|n| format!("{n} frames of ")).unwrap_or_default();
+    format!("this render ({frames}{}×{} at {} spp)", s.width, s.height, s.spp)
 }
 
 fn format_error(error: f64) -> String {

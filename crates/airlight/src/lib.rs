@@ -35,6 +35,7 @@ pub mod integrator;
 pub mod light;
 pub mod material;
 pub mod medium;
+pub mod memory;
 pub mod preview;
 pub mod radiosity;
 pub mod render;

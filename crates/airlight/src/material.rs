@@ -38,7 +38,8 @@ impl Material {
                 // Step half a square inward so that points on a face that lies
                 // on a cell boundary (a floor at y = 0) all fall in one cell.
                 let q = (p - n * (0.5 * scale)) / scale;
-                let parity = q.x.floor() as i64 + q.y.floor() as i64 + q.z.floor() as i64;
+                // Wrapping: a tiny scale sends the cell numbers to ±2⁶³.
+                let parity = (q.x.floor() as i64).wrapping_add(q.y.floor() as i64).wrapping_add(q.z.floor() as i64);
                 if parity.rem_euclid(2) == 0 { albedo } else { albedo2 }
             }
         }

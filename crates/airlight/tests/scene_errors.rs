@@ -163,7 +163,7 @@ fn cases() -> Vec<(String, usize, &'static str)> {
         (
             format!("{GOOD_TAIL}\n[[objects]]\ntype = \"mesh\"\nfile = \"no/such/file.obj\"\nmaterial = \"white\"\n"),
             18,
-            "cannot load mesh `no/such/file.obj`",
+            "cannot load mesh: no file `no/such/file.obj` in the scene's folder",
         ),
     ]
 }

@@ -27,7 +27,11 @@ pub fn run(engine: &mut Engine, script: &Script, start: &Start, frames: u32, out
     let (w, h) = engine.size();
     println!("frames: {frames} at {w}×{h}, integrator {}, threads {}", describe(engine), rayon::current_num_threads());
     let mut stats = Vec::with_capacity(frames as usize);
+    let forecast = crate::preflight::Forecast::new(frames as u64, format!("{frames} headless frames"), false);
     for k in 0..frames {
+        if let Some(warning) = forecast.advance(1) {
+            eprintln!("{warning}");
+        }
         engine.set_camera(script.camera_at(k, &start.camera));
         engine.set_lights(&script.lights_at(k, frames, &start.lights, &start.paths));
         let s = engine.frame();

@@ -45,7 +45,7 @@ pub struct ViewArgs {
     #[arg(long)]
     headless: bool,
     /// Headless: frames to run.
-    #[arg(long, default_value_t = 60, requires = "headless", value_parser = clap::value_parser!(u32).range(1..))]
+    #[arg(long, default_value_t = 60, requires = "headless", value_parser = clap::value_parser!(u32).range(1..=crate::preflight::MAX_FRAMES as i64))]
     frames: u32,
     /// Headless: the scripted camera and light path (TOML; see README, "Viewer").
     #[arg(long, value_name = "CAMERA.toml", requires = "headless")]
@@ -69,7 +69,7 @@ pub struct ViewArgs {
     #[arg(long)]
     no_dynamic_resolution: bool,
     /// Worker threads (default: all cores).
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=crate::preflight::MAX_THREADS as i64))]
     threads: Option<u32>,
 }
 
@@ -82,6 +82,16 @@ pub fn run(args: ViewArgs) -> Result<(), String> {
         ),
     };
     let scene = &file.scene;
+    let pixels = args.width as u64 * args.height as u64;
+    airlight::memory::check(
+        format!("a {}×{} view", args.width, args.height),
+        airlight::memory::render_bytes(pixels, true),
+    )
+    .map_err(|e| format!("{e}: make it smaller (--width, --height)"))?;
+    crate::preflight::warn_if_dark(scene, true);
+    if let Some(dir) = args.out.as_deref().filter(|_| args.headless) {
+        crate::outputs::check_folder("--out", dir)?;
+    }
     if !(args.period.is_finite() && args.period > 0.0) {
         return Err(format!("--period must be a positive number of seconds, got {}", args.period));
     }

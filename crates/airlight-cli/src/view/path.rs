@@ -36,6 +36,8 @@ use super::engine::Mode;
 use airlight::Camera;
 use airlight::camera::Projection;
 use airlight::light::{Keyframes, Light};
+use airlight::scene::assets::read_text;
+use airlight::scene::limits::{MAX_COORDINATE, light_extent, too_far};
 use airlight::scene::{Scene, SceneError};
 use glam::Vec3;
 use serde::Deserialize;
@@ -71,6 +73,9 @@ struct LightKey {
     position: Spanned<[f32; 3]>,
 }
 
+/// Largest path file read.
+pub const MAX_PATH_BYTES: u64 = 16 << 20;
+
 /// A camera key's position, look-at point and vertical fov (degrees).
 type Pose = (Vec3, Vec3, Option<f32>);
 
@@ -86,8 +91,7 @@ pub struct Script {
 
 /// Reads and checks a script for `scene`.
 pub fn load(path: &Path, scene: &Scene) -> Result<Script, SceneError> {
-    let text = std::fs::read_to_string(path)
-        .map_err(|e| SceneError::new(format!("cannot read the path file: {e}")).in_file(path))?;
+    let text = read_text(path, MAX_PATH_BYTES, "path file").map_err(|e| e.in_file(path))?;
     parse(&text, scene).map_err(|e| e.in_file(path))
 }
 
@@ -107,7 +111,11 @@ pub fn parse(text: &str, scene: &Scene) -> Result<Script, SceneError> {
     };
     let point = |v: &Spanned<[f32; 3]>, what: &str| -> Result<Vec3, SceneError> {
         let p = Vec3::from_array(*v.get_ref());
-        if p.is_finite() { Ok(p) } else { Err(at(v.span(), format!("{what} must be three finite numbers"))) }
+        if !p.is_finite() {
+            return Err(at(v.span(), format!("{what} must be three finite numbers")));
+        }
+        let reach = p.abs().max_element();
+        if reach > MAX_COORDINATE { Err(at(v.span(), too_far(what, reach))) } else { Ok(p) }
     };
     let frame = |v: &Spanned<i64>, what: &str, last: Option<u32>| -> Result<u32, SceneError> {
         let f = u32::try_from(*v.get_ref())
@@ -147,6 +155,9 @@ pub fn parse(text: &str, scene: &Scene) -> Result<Script, SceneError> {
             Some(v) => Some(*v.get_ref()),
             None => None,
         };
+        if let Some(&previous) = camera.last() {
+            check_between(previous, (f, (position, look_at, fov))).map_err(|m| at(k.frame.span(), m))?;
+        }
         camera.push((f, (position, look_at, fov)));
     }
 
@@ -163,9 +174,53 @@ pub fn parse(text: &str, scene: &Scene) -> Result<Script, SceneError> {
         }
         let keys: &mut Vec<(u32, Vec3)> = &mut lights[light];
         let f = frame(&k.frame, &format!("light {light}"), keys.last().map(|k| k.0))?;
-        keys.push((f, point(&k.position, "light.position")?));
+        let position = point(&k.position, "light.position")?;
+        let reach = light_extent(&scene.lights()[light].moved_to(position));
+        if reach > MAX_COORDINATE {
+            return Err(at(k.position.span(), too_far(&format!("light {light} moved there"), reach)));
+        }
+        keys.push((f, position));
     }
     Ok(Script { integrator, scene_keyframes: desc.scene_keyframes, camera, lights })
+}
+
+/// Why a camera at `position` looking at `look_at` (y up) cannot be framed.
+fn unframeable(position: Vec3, look_at: Vec3) -> Option<&'static str> {
+    if (look_at - position).length() < 1e-6 {
+        return Some("would stand on its look_at point");
+    }
+    let dir = (look_at - position).normalize();
+    (dir.cross(Vec3::Y).length() < 1e-4).then_some("would look straight up or down (y is up)")
+}
+
+/// Refuses two consecutive camera keys whose interpolation passes through
+/// a camera that cannot be framed at some frame between them. The
+/// direction d(s) = look_at − position is linear in s, and the frames
+/// where it turns vertical are those where |d_xz|² − ε²|d|² < 0, a
+/// quadratic in s: where it dips below zero at any frame, it does at the
+/// frames either side of its lowest point, so only those are tried.
+fn check_between(a: (u32, Pose), b: (u32, Pose)) -> Result<(), String> {
+    let ((f0, (p0, l0, _)), (f1, (p1, l1, _))) = (a, b);
+    let (d0, d1) = ((l0 - p0).as_dvec3(), (l1 - p1).as_dvec3());
+    let e = d1 - d0;
+    let eps2 = 1e-8;
+    let quad = |u: glam::DVec3, v: glam::DVec3| (1.0 - eps2) * (u.x * v.x + u.z * v.z) - eps2 * u.y * v.y;
+    let (qa, qb) = (quad(e, e), 2.0 * quad(d0, e));
+    let vertex = if qa > 0.0 { (-qb / (2.0 * qa)).clamp(0.0, 1.0) } else { 0.0 };
+    let at = f0 as f64 + vertex * (f1 - f0) as f64;
+    for frame in [at.floor() as u32, at.ceil() as u32] {
+        if frame <= f0 || frame >= f1 {
+            continue;
+        }
+        let t = (frame - f0) as f32 / (f1 - f0) as f32;
+        if let Some(why) = unframeable(p0.lerp(p1, t), l0.lerp(l1, t)) {
+            return Err(format!(
+                "between the camera keys at frames {f0} and {f1}, the camera at frame {frame} {why}: \
+                 add a key between them or move one"
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// The value of keyed `(frame, value)` pairs at `frame`: linear between
@@ -243,5 +298,7 @@ impl Script {
     }
 }
 
+#[cfg(test)]
+mod fuzz;
 #[cfg(test)]
 mod tests;

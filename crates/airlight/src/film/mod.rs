@@ -4,6 +4,7 @@
 //! `airlight compare` prints.
 
 mod accumulator;
+mod atomic;
 mod compare;
 pub mod partial;
 
@@ -12,8 +13,12 @@ pub use compare::{ImageError, compare, error_map};
 pub use partial::{Partial, PartialHeader};
 
 use crate::Rgb;
+use crate::scene::{MAX_IMAGE_SIDE, MAX_PIXELS};
 use std::io;
-use std::path::{Path, PathBuf};
+use std::path::Path;
+
+/// Largest EXR file read (a 16384² RGB float image uncompressed is 3 GiB).
+pub const MAX_EXR_BYTES: u64 = 4 << 30;
 
 /// How the image is turned into 8-bit PNG values (EXR output is always linear).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
@@ -134,17 +139,44 @@ impl Image {
         Ok(out.into_inner())
     }
 
-    /// Reads an EXR's RGB channels.
+    /// Reads an EXR's RGB channels. The header is read first and an image
+    /// larger than [`MAX_IMAGE_SIDE`] on a side, [`MAX_PIXELS`] in all, or
+    /// than the memory a run may take ([`crate::memory`]) is refused before
+    /// any pixel is allocated; so is anything but a regular file of at most
+    /// [`MAX_EXR_BYTES`]. Errors name the file.
     pub fn read_exr(path: &Path) -> io::Result<Image> {
         use exr::prelude::*;
+        let invalid = |why: String| io::Error::new(io::ErrorKind::InvalidData, format!("{}: {why}", path.display()));
+        let meta = std::fs::metadata(path).map_err(|e| io::Error::new(e.kind(), format!("{}: {e}", path.display())))?;
+        if !meta.is_file() {
+            return Err(invalid("not a regular file".into()));
+        }
+        if meta.len() > MAX_EXR_BYTES {
+            return Err(invalid(format!("{} bytes; an EXR may have at most {MAX_EXR_BYTES}", meta.len())));
+        }
+        let headers = exr::meta::MetaData::read_from_file(path, false).map_err(|e| invalid(e.to_string()))?;
+        for header in headers.headers.iter() {
+            let (w, h) = (header.layer_size.width() as u64, header.layer_size.height() as u64);
+            if w > MAX_IMAGE_SIDE as u64 || h > MAX_IMAGE_SIDE as u64 || w * h > MAX_PIXELS {
+                return Err(invalid(format!(
+                    "its header declares {w}×{h} pixels; at most {MAX_IMAGE_SIDE} on a side and {MAX_PIXELS} in all \
+                     are read"
+                )));
+            }
+            // The pixels, and the decoder's copy of a block of them.
+            crate::memory::check(format!("reading {w}×{h} pixels"), 2 * w * h * size_of::<Rgb>() as u64)
+                .map_err(|e| invalid(e.to_string()))?;
+        }
         let image = read_first_rgba_layer_from_file(
             path,
             |res, _| (res.width(), vec![Rgb::ZERO; res.width() * res.height()]),
             |(stride, pixels), pos, (r, g, b, _a): (f32, f32, f32, f32)| {
-                pixels[pos.y() * *stride + pos.x()] = Rgb::new(r, g, b)
+                if let Some(p) = pixels.get_mut(pos.y() * *stride + pos.x()) {
+                    *p = Rgb::new(r, g, b)
+                }
             },
         )
-        .map_err(|e| io::Error::new(io::ErrorKind::InvalidData, format!("{}: {e}", path.display())))?;
+        .map_err(|e| invalid(e.to_string()))?;
         let size = image.layer_data.size;
         let (_, pixels) = image.layer_data.channel_data.pixels;
         Ok(Self { width: size.x() as u32, height: size.y() as u32, pixels })
@@ -168,19 +200,15 @@ pub fn to_srgb8(linear: f32) -> u8 {
     (s * 255.0 + 0.5) as u8
 }
 
-/// Writes `bytes` to `path` through a temporary file in the same directory
-/// and a rename, so readers see the old file or the whole new one.
+/// Writes `bytes` to `path` whole or not at all: into a new file in the
+/// same folder (never one that exists, never through a symbolic link),
+/// flushed to disk, then renamed over `path`, so readers see the old file
+/// or the whole new one. On Linux the file has no name until it is
+/// complete (`O_TMPFILE`), so even a kill leaves nothing behind; elsewhere
+/// it is `.NAME.tmp-PID-RANDOM`, removed on every failure this function
+/// sees.
 pub fn write_atomically(path: &Path, bytes: &[u8]) -> io::Result<()> {
-    let name = path.file_name().ok_or_else(|| io::Error::new(io::ErrorKind::InvalidInput, "no file name"))?;
-    let mut tmp_name = std::ffi::OsString::from(".");
-    tmp_name.push(name);
-    tmp_name.push(format!(".tmp-{}", std::process::id()));
-    let tmp: PathBuf = path.with_file_name(tmp_name);
-    let result = std::fs::write(&tmp, bytes).and_then(|_| std::fs::rename(&tmp, path));
-    if result.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    result
+    atomic::write(path, bytes)
 }
 
 #[cfg(test)]

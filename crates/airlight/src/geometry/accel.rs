@@ -276,6 +276,13 @@ impl GeometryBuilder {
         }
         let mut bvh =
             obvhs::cwbvh::builder::build_cwbvh(&records, BvhBuildParams::medium_build(), &mut Duration::default());
+        // Many primitives with the same bounds (duplicated objects or faces)
+        // can make the tree deeper than obvhs's fixed traversal stack, which
+        // would then drop nodes without a word: such scenes are searched
+        // linearly instead, slow but right.
+        if depth(&bvh) >= MAX_BVH_DEPTH {
+            return Geometry { records, planes, unbounded, bvh: None, bounds };
+        }
         // Reorder so that the BVH's primitive ids index `records` directly.
         let ordered: Vec<Record> = bvh.primitive_indices.iter().map(|&i| records[i as usize].clone()).collect();
         for (i, index) in bvh.primitive_indices.iter_mut().enumerate() {
@@ -283,6 +290,25 @@ impl GeometryBuilder {
         }
         Geometry { records: ordered, planes, unbounded, bvh: Some(bvh), bounds }
     }
+}
+
+/// Deepest BVH traversed: obvhs's traversal stack holds 32 node groups.
+const MAX_BVH_DEPTH: usize = 30;
+
+/// Levels below the root of a compressed wide BVH.
+fn depth(bvh: &CwBvh) -> usize {
+    let mut deepest = 0;
+    let mut stack = vec![(0usize, 0usize)];
+    while let Some((index, level)) = stack.pop() {
+        deepest = deepest.max(level);
+        let Some(node) = bvh.nodes.get(index) else { continue };
+        for child in 0..8 {
+            if node.imask & (1 << child) != 0 {
+                stack.push((node.child_node_index(child) as usize, level + 1));
+            }
+        }
+    }
+    deepest
 }
 
 impl Geometry {

@@ -51,9 +51,16 @@ use std::time::{Duration, Instant};
 /// default threshold; see docs/radiosity-bench.md).
 pub const MAX_PATCHES: usize = 2_000_000;
 
+/// Peak bytes of compilation per patch (links collected before packing;
+/// 753 MB at 100,451 patches in docs/radiosity-bench.md), for the
+/// up-front memory check.
+pub const PEAK_BYTES_PER_PATCH: u64 = 8 << 10;
+
 /// Why a scene cannot be compiled.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum RadiosityError {
+    #[error("radiosity: {0}; choose a larger render.patch_size")]
+    Memory(#[from] crate::memory::MemoryError),
     #[error(
         "render.patch_size = {patch_size} would cut the scene into about {estimated} patches; \
          at most {MAX_PATCHES} are allowed: choose a larger patch_size"
@@ -192,6 +199,8 @@ impl Radiosity {
         if estimated.is_nan() || estimated > MAX_PATCHES as f64 {
             return Err(RadiosityError::TooManyPatches { patch_size: params.patch_size, estimated });
         }
+        let what = format!("compiling about {} patches (patch_size {})", estimated.round(), params.patch_size);
+        crate::memory::check(what, estimated as u64 * PEAK_BYTES_PER_PATCH)?;
         for (index, (shape, material)) in scene.objects().iter().enumerate() {
             let inner = enclosures::holds_light(shape, scene.lights(), scene.light_paths());
             patches::cut(shape, *material, index as u32, params.patch_size, square, inner, &mut patches);

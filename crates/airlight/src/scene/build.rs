@@ -1,17 +1,18 @@
 //! From a scene file to a [`Scene`]: parse, check every value, load meshes.
 //! Each error names the place in the file and what was expected.
 
+use super::assets::AssetPath;
 use super::desc::*;
-use super::{MAX_IMAGE_SIDE, MAX_SPP, RenderSettings, Scene, SceneBuilder, SceneError, default_camera, desc};
+use super::limits;
+use super::{MAX_IMAGE_SIDE, MAX_SPP, RenderSettings, Scene, SceneBuilder, SceneError, desc};
 use crate::Rgb;
-use crate::camera::{Camera, Projection};
 use crate::geometry::Shape;
-use crate::light::{Attenuation, Keyframes, Light, SpotProfile};
 use crate::material::Material;
 use crate::medium::Medium;
 use glam::{Affine3A, Quat, Vec3};
+use std::cell::{Cell, RefCell};
 use std::ops::Range;
-use std::path::Path;
+use std::path::PathBuf;
 use toml::Spanned;
 
 /// Parses scene file text into its description; errors name the line and
@@ -27,20 +28,27 @@ pub fn parse(text: &str) -> Result<SceneDesc, SceneError> {
 }
 
 /// Checks a parsed scene file (`text`, for error positions) and builds its
-/// scene. `base_dir` is where relative mesh paths start (None: the current
-/// directory). The `[render]` table's integrator options are not read here
-/// (see [`crate::SceneFile`]).
-pub fn build(desc: &SceneDesc, text: &str, base_dir: Option<&Path>) -> Result<Scene, SceneError> {
+/// scene. Mesh files are looked up in `assets` (see [`AssetPath`]); the
+/// scene lists those it read ([`Scene::files`]). The `[render]` table's
+/// integrator options are not read here (see [`crate::SceneFile`]).
+pub fn build(desc: &SceneDesc, text: &str, assets: &AssetPath) -> Result<Scene, SceneError> {
     // The same text parsed to a spanned document: where each key and value
     // stands, for errors found after deserializing.
     let document = toml::de::DeTable::parse(text).map(|d| d.into_inner()).unwrap_or_default();
-    Checker { text, base_dir, document }.scene(desc)
+    let checker = Checker { text, assets, document, files: RefCell::default(), mesh_bytes: Cell::new(0) };
+    let mut scene = checker.scene(desc)?;
+    scene.files = checker.files.into_inner();
+    Ok(scene)
 }
 
 pub(super) struct Checker<'a> {
     text: &'a str,
-    base_dir: Option<&'a Path>,
+    pub(super) assets: &'a AssetPath,
     document: toml::de::DeTable<'a>,
+    /// The files read so far (meshes).
+    pub(super) files: RefCell<Vec<PathBuf>>,
+    /// Memory the meshes read so far will take.
+    pub(super) mesh_bytes: Cell<u64>,
 }
 
 pub(super) type Result<T, E = SceneError> = std::result::Result<T, E>;
@@ -162,7 +170,7 @@ impl Checker<'_> {
         if v.is_finite() { Ok(v) } else { Err(self.err_field(span, what, format!("{what} must be finite, got {v}"))) }
     }
 
-    fn non_negative3(&self, span: Range<usize>, what: &str, v: Vec3) -> Result<Vec3> {
+    pub(super) fn non_negative3(&self, span: Range<usize>, what: &str, v: Vec3) -> Result<Vec3> {
         if v.is_finite() && v.min_element() >= 0.0 {
             Ok(v)
         } else {
@@ -170,76 +178,40 @@ impl Checker<'_> {
         }
     }
 
-    pub(super) fn nonzero3(&self, span: Range<usize>, what: &str, v: Vec3) -> Result<Vec3> {
+    /// A direction: finite, not zero, returned at unit length (made so in
+    /// f64, so that neither 1e20 nor 1e-30 on an axis is lost to f32).
+    pub(super) fn direction(&self, span: Range<usize>, what: &str, v: Vec3) -> Result<Vec3> {
         let v = self.finite3(span.clone(), what, v)?;
-        if v.length_squared() > 0.0 {
-            Ok(v)
-        } else {
-            Err(self.err_field(span, what, format!("{what} must not be zero")))
-        }
+        limits::unit(v).ok_or_else(|| self.err_field(span, what, format!("{what} must not be zero")))
     }
 
-    fn camera(&self, desc: &Spanned<CameraDesc>) -> Result<Camera> {
-        let span = desc.span();
-        let c = desc.get_ref();
-        let point = |v: Option<Point>, name: &str, default: Vec3| -> Result<Vec3> {
-            self.finite3(span.clone(), &format!("camera.{name}"), v.map_or(default, |p| p.0))
-        };
-        let default = default_camera();
-        let look_at = point(c.look_at, "look_at", Vec3::new(0.0, 1.0, 0.0))?;
-        let up = self.nonzero3(span.clone(), "camera.up", c.up.map_or(Vec3::Y, |p| p.0))?;
-        let position = match c.kind {
-            CameraType::Isometric => {
-                if c.position.is_some() {
-                    return Err(self.err(span, "an isometric camera is placed by look_at and distance, not position"));
-                }
-                let distance = self.positive(span.clone(), "camera.distance", c.distance.unwrap_or(50.0))?;
-                look_at - crate::camera::ISOMETRIC_VIEW * distance
-            }
-            _ => point(c.position, "position", default.position)?,
-        };
-        let forward = look_at - position;
-        if forward.length_squared() == 0.0 {
-            return Err(self.err_field(span, "look_at", "camera.position and camera.look_at must differ"));
+    /// A quad's edges: not parallel (in f64), and making a normal in f32.
+    pub(super) fn edges(&self, span: Range<usize>, label: &str, u: Vec3, v: Vec3) -> Result<()> {
+        let reach = limits::reach_of(u).max(limits::reach_of(v));
+        if reach > limits::MAX_COORDINATE {
+            return Err(self.err_field(span, "edge_u", limits::too_far(&format!("{label}.edge_u or edge_v"), reach)));
         }
-        if forward.normalize().cross(up.normalize()).length() < 1e-6 {
-            return Err(self.err(span, "camera.up must not be parallel to the view direction"));
+        let parallel = limits::unit(u).is_none() || limits::unit(v).is_none() || limits::sin_between(u, v) == 0.0;
+        if parallel {
+            return Err(self.err_field(
+                span,
+                "edge_v",
+                format!("{label}: edge_u and edge_v must not be parallel or zero"),
+            ));
         }
-        let projection = match c.kind {
-            CameraType::Perspective => {
-                if c.view_height.is_some() {
-                    return Err(self.err_field(
-                        span,
-                        "view_height",
-                        "view_height is for orthographic cameras; a perspective camera takes fov",
-                    ));
-                }
-                let fov = c.fov.unwrap_or(40.0);
-                if !(fov > 0.0 && fov < 180.0) {
-                    return Err(self.err_field(
-                        span,
-                        "fov",
-                        format!("camera.fov must be between 0 and 180 degrees, got {fov}"),
-                    ));
-                }
-                Projection::Perspective { fov_degrees: fov }
-            }
-            CameraType::Orthographic | CameraType::Isometric => {
-                if c.fov.is_some() {
-                    return Err(self.err_field(
-                        span,
-                        "fov",
-                        "fov is for perspective cameras; an orthographic camera takes view_height",
-                    ));
-                }
-                let h = self.positive(span.clone(), "camera.view_height", c.view_height.unwrap_or(10.0))?;
-                Projection::Orthographic { view_height: h }
-            }
-        };
-        let aperture = self.non_negative(span.clone(), "camera.aperture", c.aperture.unwrap_or(0.0))?;
-        let focus = c.focus_distance.unwrap_or(forward.length());
-        let focus = self.positive(span, "camera.focus_distance", focus)?;
-        Ok(Camera::oriented(position, look_at, up, projection).with_lens(aperture, focus))
+        // The quad's normal and area come from |u × v|² in f32.
+        if !u.cross(v).length_squared().is_normal() {
+            let exact = u.as_dvec3().cross(v.as_dvec3()).length();
+            return Err(self.err_field(
+                span,
+                "edge_v",
+                format!(
+                    "{label}: the area |edge_u × edge_v| = {exact:.3e} is too small for 32-bit floats; \
+                     it must be at least 1.1e-19"
+                ),
+            ));
+        }
+        Ok(())
     }
 
     fn medium(&self, desc: &Spanned<MediumDesc>) -> Result<Medium> {
@@ -357,18 +329,12 @@ impl Checker<'_> {
                 Shape::sphere(get(o.center, "center")?, radius)
             }
             ObjectType::Plane => {
-                let normal = self.nonzero3(span.clone(), &format!("{label}.normal"), o.normal.unwrap().0)?;
+                let normal = self.direction(span.clone(), &format!("{label}.normal"), o.normal.unwrap().0)?;
                 Shape::plane(get(o.point, "point")?, normal)
             }
             ObjectType::Quad => {
                 let (u, v) = (get(o.edge_u, "edge_u")?, get(o.edge_v, "edge_v")?);
-                if u.cross(v).length_squared() == 0.0 {
-                    return Err(self.err_field(
-                        span,
-                        "edge_v",
-                        format!("{label}: edge_u and edge_v must not be parallel or zero"),
-                    ));
-                }
+                self.edges(span.clone(), &label, u, v)?;
                 Shape::quad(get(o.corner, "corner")?, u, v)
             }
             ObjectType::Box => {
@@ -401,7 +367,28 @@ impl Checker<'_> {
                 return Err(self.err(span, format!("{label} needs a `material` (a name from [materials])")));
             }
         };
-        Ok((shape.transformed(transform), material))
+        Ok((self.placed(span, &label, shape.transformed(transform))?, material))
+    }
+
+    /// A shape in world space, checked for what its transform may have
+    /// pushed out of f32's range: too far, edges or a normal lost.
+    fn placed(&self, span: Range<usize>, label: &str, shape: Shape) -> Result<Shape> {
+        let extent = limits::shape_extent(&shape);
+        // Never NaN: a shape with a non-finite point reaches infinity.
+        if extent > limits::MAX_COORDINATE {
+            return Err(self.err(span, limits::too_far(label, extent)));
+        }
+        match &shape {
+            Shape::Quad { edge_u, edge_v, .. } => self.edges(span, label, *edge_u, *edge_v)?,
+            Shape::Plane { normal, .. } if !normal.is_normalized() => {
+                return Err(self.err_field(span, "scale", format!("{label}: its scale leaves the plane no normal")));
+            }
+            Shape::Transformed { world_from_local, .. } if !world_from_local.inverse().is_finite() => {
+                return Err(self.err_field(span, "scale", format!("{label}: its scale is too small to invert")));
+            }
+            _ => {}
+        }
+        Ok(shape)
     }
 
     /// Checks that an object or light has every field its type needs and
@@ -461,223 +448,6 @@ impl Checker<'_> {
         let r = rotate * (std::f32::consts::PI / 180.0);
         let rotation = Quat::from_rotation_z(r.z) * Quat::from_rotation_y(r.y) * Quat::from_rotation_x(r.x);
         Ok(Affine3A::from_scale_rotation_translation(scale, rotation, translate))
-    }
-
-    fn mesh(&self, label: &str, file: &Spanned<String>) -> Result<Shape> {
-        let path = match self.base_dir {
-            Some(dir) => dir.join(file.get_ref()),
-            None => file.get_ref().into(),
-        };
-        let fail =
-            |why: String| self.err(file.span(), format!("{label}: cannot load mesh `{}`: {why}", path.display()));
-        let options = tobj::LoadOptions { triangulate: true, single_index: true, ..Default::default() };
-        let (models, _) = tobj::load_obj(&path, &options).map_err(|e| fail(e.to_string()))?;
-        let mut positions = Vec::new();
-        let mut triangles = Vec::new();
-        for model in &models {
-            let m = &model.mesh;
-            let base = positions.len() as u32;
-            for p in m.positions.chunks_exact(3) {
-                let v = Vec3::new(p[0], p[1], p[2]);
-                if !v.is_finite() {
-                    return Err(fail(format!("vertex {} is not finite", positions.len())));
-                }
-                positions.push(v);
-            }
-            let count = m.positions.len() / 3;
-            for t in m.indices.chunks_exact(3) {
-                if t.iter().any(|&i| i as usize >= count) {
-                    return Err(fail(format!("a face refers to vertex {} of {count}", t.iter().max().unwrap() + 1)));
-                }
-                triangles.push([base + t[0], base + t[1], base + t[2]]);
-            }
-        }
-        if triangles.is_empty() {
-            return Err(fail("it holds no faces".into()));
-        }
-        Ok(Shape::Mesh { positions, triangles })
-    }
-
-    fn light(&self, index: usize, desc: &Spanned<LightDesc>) -> Result<Light> {
-        let span = desc.span();
-        let l = desc.get_ref();
-        let kind = format!("{:?}", l.kind).to_lowercase();
-        let label = format!("lights[{index}] ({kind})");
-        let fields: [(&str, bool); 22] = [
-            ("min", l.min.is_some()),
-            ("max", l.max.is_some()),
-            ("volume", l.volume.is_some()),
-            ("position", l.position.is_some()),
-            ("intensity", l.intensity.is_some()),
-            ("direction", l.direction.is_some()),
-            ("look_at", l.look_at.is_some()),
-            ("cone_angle", l.cone_angle.is_some()),
-            ("falloff_start", l.falloff_start.is_some()),
-            ("profile", l.profile.is_some()),
-            ("irradiance", l.irradiance.is_some()),
-            ("center", l.center.is_some()),
-            ("radius", l.radius.is_some()),
-            ("radiance", l.radiance.is_some()),
-            ("corner", l.corner.is_some()),
-            ("edge_u", l.edge_u.is_some()),
-            ("edge_v", l.edge_v.is_some()),
-            ("attenuation", l.attenuation.is_some()),
-            ("cutoff", l.cutoff.is_some()),
-            ("range", l.range.is_some()),
-            ("start", l.start.is_some()),
-            ("end", l.end.is_some()),
-        ];
-        let at = |name: &str| format!("{label}.{name}");
-        let point = |p: Option<Point>, name: &str| self.finite3(span.clone(), &at(name), p.unwrap().0);
-        let power = |t: Option<Triple>, name: &str| self.non_negative3(span.clone(), &at(name), t.unwrap().0);
-        let check = |required: &[&str], optional: &[&str]| {
-            self.check_fields(span.clone(), &label, &kind, &fields, required, optional)
-        };
-        const FALLOFF: [&str; 3] = ["attenuation", "cutoff", "range"];
-        let light = match l.kind {
-            LightType::Point => {
-                check(&["position", "intensity"], &[&FALLOFF[..], &["radius"]].concat())?;
-                Light::point(point(l.position, "position")?, power(l.intensity, "intensity")?)
-            }
-            LightType::Spot => {
-                let optional = ["cone_angle", "falloff_start", "profile", "direction", "look_at", "radius"];
-                check(&["position", "intensity"], &[&FALLOFF[..], &optional].concat())?;
-                let position = point(l.position, "position")?;
-                let direction = match (l.direction, l.look_at) {
-                    (Some(d), None) => self.nonzero3(span.clone(), &at("direction"), d.0)?,
-                    (None, Some(t)) => self
-                        .nonzero3(span.clone(), &at("look_at"), t.0 - position)
-                        .map_err(|_| self.err(span.clone(), format!("{label}: look_at must differ from position")))?,
-                    (Some(_), Some(_)) => {
-                        return Err(self.err(span, format!("{label}: give direction or look_at, not both")));
-                    }
-                    (None, None) => {
-                        return Err(self.err(span, format!("{label}: a spot needs `direction` or `look_at`")));
-                    }
-                };
-                let cone = l.cone_angle.unwrap_or(30.0);
-                if !(cone > 0.0 && cone <= 180.0) {
-                    return Err(self.err_field(
-                        span,
-                        "cone_angle",
-                        format!("{label}.cone_angle must be in (0, 180] degrees, got {cone}"),
-                    ));
-                }
-                let start = l.falloff_start.unwrap_or(cone);
-                if !(start >= 0.0 && start <= cone) {
-                    return Err(self.err_field(
-                        span,
-                        "falloff_start",
-                        format!("{label}.falloff_start must be in [0, cone_angle = {cone}] degrees, got {start}"),
-                    ));
-                }
-                Light::Spot {
-                    position,
-                    direction: direction.normalize(),
-                    intensity: power(l.intensity, "intensity")?,
-                    cone_angle: cone.to_radians(),
-                    falloff_start: start.to_radians(),
-                    profile: l.profile.map_or(SpotProfile::Smoothstep, Into::into),
-                    attenuation: Attenuation::PHYSICAL,
-                }
-            }
-            LightType::Distant => {
-                check(&["direction", "irradiance"], &[])?;
-                let d = self.nonzero3(span.clone(), &at("direction"), l.direction.unwrap().0)?;
-                return Ok(Light::distant(d, power(l.irradiance, "irradiance")?));
-            }
-            LightType::Sphere if l.volume == Some(true) => {
-                check(&["center", "radius", "intensity"], &["volume"])?;
-                let radius = self.positive(span.clone(), &at("radius"), l.radius.unwrap())?;
-                return Ok(Light::volume_sphere(point(l.center, "center")?, radius, power(l.intensity, "intensity")?));
-            }
-            LightType::Box => {
-                check(&["min", "max", "intensity"], &[])?;
-                let (min, max) = (point(l.min, "min")?, point(l.max, "max")?);
-                if !min.cmplt(max).all() {
-                    return Err(self.err_field(
-                        span,
-                        "max",
-                        format!("{label}: min must be less than max on every axis, got min {min} max {max}"),
-                    ));
-                }
-                return Ok(Light::volume_box(min, max, power(l.intensity, "intensity")?));
-            }
-            LightType::Sphere => {
-                check(&["center", "radius", "radiance"], &[&FALLOFF[..], &["volume"]].concat())?;
-                let radius = self.positive(span.clone(), &at("radius"), l.radius.unwrap())?;
-                Light::sphere(point(l.center, "center")?, radius, power(l.radiance, "radiance")?)
-            }
-            LightType::Quad => {
-                check(&["corner", "edge_u", "edge_v", "radiance"], &[])?;
-                let (u, v) = (point(l.edge_u, "edge_u")?, point(l.edge_v, "edge_v")?);
-                if u.cross(v).length_squared() == 0.0 {
-                    return Err(self.err_field(
-                        span,
-                        "edge_v",
-                        format!("{label}: edge_u and edge_v must not be parallel or zero"),
-                    ));
-                }
-                return Ok(Light::quad(point(l.corner, "corner")?, u, v, power(l.radiance, "radiance")?));
-            }
-            LightType::Line => {
-                check(&["start", "end", "intensity"], &[])?;
-                let (a, b) = (point(l.start, "start")?, point(l.end, "end")?);
-                if a == b {
-                    return Err(self.err_field(span, "end", format!("{label}: start and end must differ")));
-                }
-                return Ok(Light::line(a, b, power(l.intensity, "intensity")?));
-            }
-        };
-        // The falloff of a point, spot or sphere light.
-        let radius = match l.radius {
-            Some(r) => self.positive(span.clone(), &at("radius"), r)?,
-            None => Attenuation::PHYSICAL.radius,
-        };
-        let cutoff = l.cutoff.map(|c| self.positive(span.clone(), &at("cutoff"), c)).transpose()?;
-        let range = l.range.map(|r| self.positive(span.clone(), &at("range"), r)).transpose()?;
-        let model = l.attenuation.unwrap_or_default();
-        // E₀, the irradiance at the light's surface, in its brightest channel.
-        let e0 = light.intensity().max_element() / (radius * radius);
-        let attenuation = Attenuation::new(model, radius, e0, cutoff, range)
-            .map_err(|why| self.err_field(span.clone(), "attenuation", format!("{label}: {why}")))?;
-        Ok(light.with_attenuation(attenuation))
-    }
-}
-
-impl Checker<'_> {
-    /// A light's `keyframes`: times in [0, 1], strictly increasing, finite
-    /// positions; not on a distant light.
-    fn keyframes(&self, index: usize, desc: &Spanned<LightDesc>, light: &Light) -> Result<Option<Keyframes>> {
-        let Some(keys) = &desc.get_ref().keyframes else {
-            return Ok(None);
-        };
-        let label = format!("lights[{index}].keyframes");
-        if light.position().is_none() {
-            return Err(self.err(keys.span(), format!("{label}: a distant light has no position to move")));
-        }
-        if keys.get_ref().is_empty() {
-            return Err(self.err(keys.span(), format!("{label} needs at least one {{ time, position }} key")));
-        }
-        let mut out = Vec::with_capacity(keys.get_ref().len());
-        for (k, key) in keys.get_ref().iter().enumerate() {
-            let KeyframeDesc { time, position } = key.get_ref();
-            if !(0.0..=1.0).contains(time) {
-                return Err(self.err(key.span(), format!("{label}[{k}].time must lie in [0, 1], got {time}")));
-            }
-            let previous = out.last().map(|&(t, _): &(f32, Vec3)| t);
-            if let Some(previous) = previous.filter(|&p| *time <= p) {
-                return Err(self.err(
-                    key.span(),
-                    format!("{label}[{k}].time must be greater than the previous key's ({previous}), got {time}"),
-                ));
-            }
-            if !position.0.is_finite() {
-                return Err(self.err(key.span(), format!("{label}[{k}].position must be finite, got {}", position.0)));
-            }
-            out.push((*time, position.0));
-        }
-        Ok(Keyframes::new(out))
     }
 }
 

@@ -8,12 +8,20 @@
 //! moving a light ([`Scene::set_lights`], [`Scene::at_time`]) moves its
 //! visible surface and the shadow it casts, and re-sorts the light culling.
 
+pub mod assets;
 mod build;
+mod build_camera;
+mod build_lights;
 pub mod desc;
 mod error;
 mod lights;
+pub mod limits;
+mod mesh;
+pub mod obj;
 mod sdf;
+mod warnings;
 
+pub use assets::AssetPath;
 pub use build::{build, parse};
 pub use desc::SceneDesc;
 pub use error::{SceneError, line_col};
@@ -142,9 +150,18 @@ pub struct Scene {
     bounds_center: Vec3,
     bounds_radius: f32,
     light_culling: LightCulling,
+    /// The files the scene was read from (see [`Scene::files`]).
+    pub(crate) files: Vec<std::path::PathBuf>,
 }
 
 impl Scene {
+    /// The files a scene file's scene was read from, symbolic links
+    /// resolved: the scene file, then its meshes (empty for a scene built
+    /// in code). Outputs must not replace them.
+    pub fn files(&self) -> &[std::path::PathBuf] {
+        &self.files
+    }
+
     pub fn settings(&self) -> &RenderSettings {
         &self.settings
     }
@@ -507,6 +524,7 @@ impl SceneBuilder {
             bounds_center: Vec3::ZERO,
             bounds_radius: 1.0,
             light_culling,
+            files: Vec::new(),
         };
         scene.geometry = build_geometry(scene.surfaces());
         scene.update_bounds();

@@ -116,8 +116,8 @@ impl Checker<'_> {
                 }
             }
             SdfShape::Plane => {
-                let normal = self.nonzero3(span.clone(), &format!("{label}.normal"), n.normal.unwrap().0)?;
-                Sdf::Plane { point: point(n.point, "point", Vec3::ZERO)?, normal: normal.normalize() }
+                let normal = self.direction(span.clone(), &format!("{label}.normal"), n.normal.unwrap().0)?;
+                Sdf::Plane { point: point(n.point, "point", Vec3::ZERO)?, normal }
             }
             SdfShape::Union | SdfShape::Intersection | SdfShape::Subtraction | SdfShape::SmoothUnion => {
                 let children = n.children.as_deref().unwrap_or_default();

@@ -2,8 +2,9 @@
 //! asks for. The scene format is described in docs/scene-format.md.
 
 use crate::integrator::IntegratorDesc;
-use crate::scene::{self, Scene, SceneError};
-use std::path::Path;
+use crate::scene::assets::read_text;
+use crate::scene::{self, AssetPath, Scene, SceneError};
+use std::path::{Path, PathBuf};
 
 /// A scene file, read and checked: the scene and the integrator it names,
 /// with the options of every integrator its `[render]` table sets.
@@ -13,22 +14,41 @@ pub struct SceneFile {
     pub integrator: IntegratorDesc,
 }
 
+/// Largest scene file read.
+pub const MAX_SCENE_BYTES: u64 = 16 << 20;
+
 impl SceneFile {
-    /// Reads the scene file at `path`; meshes are found relative to it.
-    /// Errors name the file, line and column.
+    /// Reads the scene file at `path`; meshes are found in its folder (see
+    /// [`AssetPath`]). Errors name the file, line and column.
     pub fn load(path: &Path) -> Result<SceneFile, SceneError> {
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| SceneError::new(format!("cannot read the scene file: {e}")).in_file(path))?;
-        Self::from_toml_str(&text, path.parent()).map_err(|e| e.in_file(path))
+        Self::load_with(path, &[])
     }
 
-    /// Reads scene file text. `base_dir` is where relative mesh paths start
+    /// [`SceneFile::load`], with meshes also looked for in `asset_dirs`,
+    /// after the scene's folder ([`AssetPath::from_env`] reads them from
+    /// `AIRLIGHT_ASSET_PATH`).
+    pub fn load_with(path: &Path, asset_dirs: &[PathBuf]) -> Result<SceneFile, SceneError> {
+        let text = read_text(path, MAX_SCENE_BYTES, "scene file").map_err(|e| e.in_file(path))?;
+        let assets = AssetPath::new(path.parent(), asset_dirs);
+        let mut file = Self::from_toml_with(&text, &assets).map_err(|e| e.in_file(path))?;
+        let mut files = vec![path.canonicalize().unwrap_or_else(|_| path.to_path_buf())];
+        files.append(&mut file.scene.files);
+        file.scene.files = files;
+        Ok(file)
+    }
+
+    /// Reads scene file text. `base_dir` is where mesh files are found
     /// (None: the current directory).
     pub fn from_toml_str(text: &str, base_dir: Option<&Path>) -> Result<SceneFile, SceneError> {
+        Self::from_toml_with(text, &AssetPath::new(base_dir, &[]))
+    }
+
+    /// Reads scene file text, with mesh files found in `assets`.
+    pub fn from_toml_with(text: &str, assets: &AssetPath) -> Result<SceneFile, SceneError> {
         let desc = scene::parse(text)?;
         let integrator = IntegratorDesc::from_render_desc(&desc.render, desc.medium.is_some())
             .map_err(|e| SceneError::at(text, e.span.start, e.message))?;
-        let scene = scene::build(&desc, text, base_dir)?;
+        let scene = scene::build(&desc, text, assets)?;
         Ok(SceneFile { scene, integrator })
     }
 }

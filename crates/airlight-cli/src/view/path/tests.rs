@@ -96,3 +96,38 @@ fn a_missing_file_names_the_file() {
     let e = load(Path::new("/nonexistent/camera.toml"), &scene()).unwrap_err().to_string();
     assert!(e.starts_with("/nonexistent/camera.toml: cannot read the path file"), "{e}");
 }
+
+#[test]
+fn a_camera_interpolated_through_its_target_is_refused_with_the_frame() {
+    // Between these keys the camera passes through the point it looks at
+    // (frame 15: position = look_at = [0, 1, 0]).
+    let through = "[[camera]]\nframe = 0\nposition = [0, 1, -5]\nlook_at = [0, 1, 5]\n\n\
+                   [[camera]]\nframe = 30\nposition = [0, 1, 5]\nlook_at = [0, 1, -5]\n";
+    let e = err(through);
+    assert!(e.starts_with("line 7, column 9:"), "{e}");
+    assert!(
+        e.contains("between the camera keys at frames 0 and 30, the camera at frame 15 would stand on its look_at")
+    );
+    // Turning to look straight down on the way: refused at the frame it does.
+    let down = "[[camera]]\nframe = 0\nposition = [-1, 5, 0]\nlook_at = [1, 0, 0]\n\n\
+                [[camera]]\nframe = 10\nposition = [1, 5, 0]\nlook_at = [-1, 0, 0]\n";
+    let e = err(down);
+    assert!(e.contains("the camera at frame 5 would look straight up or down"), "{e}");
+    // Passing near but not through at any frame is fine.
+    let near = "[[camera]]\nframe = 0\nposition = [-1, 5, 0]\nlook_at = [1, 0, 0]\n\n\
+                [[camera]]\nframe = 9\nposition = [1, 5, 0.5]\nlook_at = [-1, 0, 0.5]\n";
+    let s = scene();
+    let script = parse(near, &s).unwrap();
+    for frame in 0..10 {
+        let c = script.camera_at(frame, s.camera());
+        assert!(c.forward.is_finite() && c.right.is_finite(), "frame {frame}");
+    }
+}
+
+#[test]
+fn keys_far_away_are_refused_with_the_limit() {
+    let e = err("[[camera]]\nframe = 0\nposition = [0, 1, -1e30]\nlook_at = [0, 1, 0]\n");
+    assert!(e.starts_with("line 3,") && e.contains("reaches 1e30 world units from the origin"), "{e}");
+    let e = err("[[light]]\nlight = 0\nframe = 0\nposition = [0, 1e12, 0]\n");
+    assert!(e.starts_with("line 4,") && e.contains("within 1e9"), "{e}");
+}

@@ -1,0 +1,98 @@
+//! The `[camera]` table: where it stands and looks, checked so that the
+//! camera it makes frames an image in f32 (positions within range, the
+//! view direction and up made and compared in f64).
+
+use super::build::{Checker, Result};
+use super::default_camera;
+use super::desc::*;
+use super::limits;
+use crate::camera::{Camera, Projection};
+use glam::Vec3;
+use toml::Spanned;
+
+impl Checker<'_> {
+    pub(super) fn camera(&self, desc: &Spanned<CameraDesc>) -> Result<Camera> {
+        let span = desc.span();
+        let c = desc.get_ref();
+        let point = |v: Option<Point>, name: &str, default: Vec3| -> Result<Vec3> {
+            self.finite3(span.clone(), &format!("camera.{name}"), v.map_or(default, |p| p.0))
+        };
+        let default = default_camera();
+        let look_at = point(c.look_at, "look_at", Vec3::new(0.0, 1.0, 0.0))?;
+        let up = self.direction(span.clone(), "camera.up", c.up.map_or(Vec3::Y, |p| p.0))?;
+        let position = match c.kind {
+            CameraType::Isometric => {
+                if c.position.is_some() {
+                    return Err(self.err(span, "an isometric camera is placed by look_at and distance, not position"));
+                }
+                let distance = self.positive(span.clone(), "camera.distance", c.distance.unwrap_or(50.0))?;
+                look_at - crate::camera::ISOMETRIC_VIEW * distance
+            }
+            _ => point(c.position, "position", default.position)?,
+        };
+        for (name, p) in [("position", position), ("look_at", look_at)] {
+            let extent = limits::reach_of(p);
+            if extent > limits::MAX_COORDINATE {
+                // An isometric camera's position comes from its distance.
+                let name = if c.kind == CameraType::Isometric && name == "position" { "distance" } else { name };
+                return Err(self.err_field(span.clone(), name, limits::too_far(&format!("camera.{name}"), extent)));
+            }
+        }
+        let forward = look_at - position;
+        if forward == Vec3::ZERO {
+            return Err(self.err_field(span, "look_at", "camera.position and camera.look_at must differ"));
+        }
+        if forward.try_normalize().is_none() {
+            return Err(self.err_field(
+                span,
+                "look_at",
+                format!(
+                    "camera.position and camera.look_at are only {:e} apart, too close for a direction in 32-bit floats",
+                    forward.as_dvec3().length()
+                ),
+            ));
+        }
+        if limits::sin_between(forward, up) < 1e-6 {
+            return Err(self.err_field(span, "up", "camera.up must not be parallel to the view direction"));
+        }
+        let projection = match c.kind {
+            CameraType::Perspective => {
+                if c.view_height.is_some() {
+                    return Err(self.err_field(
+                        span,
+                        "view_height",
+                        "view_height is for orthographic cameras; a perspective camera takes fov",
+                    ));
+                }
+                let fov = c.fov.unwrap_or(40.0);
+                if !(fov > 0.0 && fov < 180.0) {
+                    return Err(self.err_field(
+                        span,
+                        "fov",
+                        format!("camera.fov must be between 0 and 180 degrees, got {fov}"),
+                    ));
+                }
+                Projection::Perspective { fov_degrees: fov }
+            }
+            CameraType::Orthographic | CameraType::Isometric => {
+                if c.fov.is_some() {
+                    return Err(self.err_field(
+                        span,
+                        "fov",
+                        "fov is for perspective cameras; an orthographic camera takes view_height",
+                    ));
+                }
+                let h = self.positive(span.clone(), "camera.view_height", c.view_height.unwrap_or(10.0))?;
+                Projection::Orthographic { view_height: h }
+            }
+        };
+        let aperture = self.non_negative(span.clone(), "camera.aperture", c.aperture.unwrap_or(0.0))?;
+        let focus = c.focus_distance.unwrap_or(forward.length());
+        let focus = self.positive(span.clone(), "camera.focus_distance", focus)?;
+        let camera = Camera::oriented(position, look_at, up, projection).with_lens(aperture, focus);
+        if ![camera.forward, camera.right, camera.up].iter().all(|v| v.is_finite() && v.is_normalized()) {
+            return Err(self.err(span, "the camera's view direction and up do not frame an image in 32-bit floats"));
+        }
+        Ok(camera)
+    }
+}
