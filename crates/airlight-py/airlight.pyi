@@ -6,6 +6,7 @@ Images are linear RGB, ``float32`` arrays of shape (height, width, 3).
 """
 
 import os
+import pathlib
 from collections.abc import Callable, Mapping, Sequence
 from typing import Any, Literal, Protocol, TypedDict, Union, overload
 
@@ -104,6 +105,9 @@ class Scene:
     @property
     def toml(self) -> str:
         """The scene as TOML: the file or text read, or what the dicts were written as."""
+    @property
+    def path(self) -> pathlib.Path | None:
+        """The scene file read by :func:`load`, else None."""
     def at_time(self, time: float) -> Scene:
         """The scene with its keyframed lights at ``time`` in [0, 1] (held at the end keys
         outside). It shares this scene's integrator, which is told the lights moved:
@@ -174,13 +178,20 @@ class Scene:
         on this thread at most every 0.1 s. The GIL is released while rendering; Ctrl-C stops
         the render and raises KeyboardInterrupt. ``aovs=True`` returns a dict with ``color`` and
         ``variance``.
+
+        As ``airlight render`` does, an image too large for the memory left (or for
+        ``AIRLIGHT_MEMORY_LIMIT``) raises ``MemoryError`` before anything is allocated, and a
+        scene that can only render black gives a ``UserWarning`` saying why.
         """
 
 def load(path: _Path) -> Scene:
-    """Reads a scene file; a bad one raises ``SceneError`` with the CLI's message."""
+    """Reads a scene file as ``airlight render`` does; a bad one raises ``SceneError`` with the
+    CLI's message (``file:line:col: message``). Meshes are found in the file's folder, then in
+    the folders of ``AIRLIGHT_ASSET_PATH``."""
 
 def loads(text: str, base_dir: _Path | None = None) -> Scene:
-    """Reads a scene from TOML text; relative mesh paths start at ``base_dir``."""
+    """Reads a scene from TOML text; meshes are found in ``base_dir`` (default: the current
+    folder), then in the folders of ``AIRLIGHT_ASSET_PATH``."""
 
 def from_dict(scene: Mapping[str, Any], base_dir: _Path | None = None) -> Scene:
     """The same as ``Scene(scene, base_dir)``."""

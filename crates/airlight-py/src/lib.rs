@@ -8,6 +8,7 @@ mod options;
 mod render;
 mod scene;
 
+use airlight::scene::AssetPath;
 use errors::{Origin, guard};
 use numpy::{AllowTypeChange, PyArray3, PyArrayLikeDyn};
 use pyo3::exceptions::{PyOSError, PyValueError};
@@ -15,30 +16,32 @@ use pyo3::prelude::*;
 use scene::{PyScene, Source};
 use std::path::PathBuf;
 
-/// Reads a scene file; errors are `SceneError`s with the CLI's message
-/// (`file:line:col: message`). Meshes are found relative to the file.
+/// Reads a scene file as `airlight render` does; errors are `SceneError`s
+/// with the CLI's message (`file:line:col: message`). Meshes are found in
+/// the file's folder, then in those of `AIRLIGHT_ASSET_PATH`.
 #[pyfunction]
 fn load(py: Python<'_>, path: PathBuf) -> PyResult<PyScene> {
     guard(|| {
-        let text = match std::fs::read_to_string(&path) {
-            Ok(text) => text,
-            // The library's own message for a file it cannot read.
-            Err(_) => match airlight::SceneFile::load(&path) {
-                Err(e) => return Err(errors::scene_error(py, &e, &Origin::File, "")),
-                Ok(_) => return Err(PyOSError::new_err(format!("cannot read `{}`", path.display()))),
-            },
-        };
-        let base_dir = path.parent().map(PathBuf::from);
-        scene::read(py, Source { text, base_dir, origin: Origin::File, file: Some(path) })
+        let extra = AssetPath::from_env();
+        let file = py
+            .detach(|| airlight::SceneFile::load_with(&path, &extra))
+            .map_err(|e| errors::scene_error(py, &e, &Origin::File, ""))?;
+        // Kept for `Scene.toml` and `with_lights`; the library has just
+        // read it, within its size limit.
+        let text = std::fs::read_to_string(&path)
+            .map_err(|e| PyOSError::new_err(format!("cannot read `{}`: {e}", path.display())))?;
+        let assets = AssetPath::new(path.parent(), &extra);
+        Ok(scene::new_scene(file, Source { text, assets, origin: Origin::File, file: Some(path) }))
     })
 }
 
 /// Reads a scene from TOML text; errors say `line L, column C: message`.
-/// Relative mesh paths start at `base_dir` (default: the current directory).
+/// Meshes are found in `base_dir` (default: the current folder), then in
+/// the folders of `AIRLIGHT_ASSET_PATH`.
 #[pyfunction]
 #[pyo3(signature = (text, base_dir=None))]
 fn loads(py: Python<'_>, text: String, base_dir: Option<PathBuf>) -> PyResult<PyScene> {
-    guard(|| scene::read(py, Source { text, base_dir, origin: Origin::Text, file: None }))
+    guard(|| scene::read(py, Source::text(text, base_dir.as_deref(), Origin::Text)))
 }
 
 /// A scene from dicts with the scene file's keys; the same as `Scene(d)`.
@@ -62,8 +65,9 @@ struct Comparison {
     max: f64,
     /// √(Σ(a − b)² / Σb²)
     rel_rmse: f64,
-    /// The images' mean colours.
+    /// The mean colour of `image`.
     mean_a: (f32, f32, f32),
+    /// The mean colour of `reference`.
     mean_b: (f32, f32, f32),
 }
 
@@ -108,6 +112,28 @@ fn image(a: &PyArrayLikeDyn<'_, f32, AllowTypeChange>, what: &str) -> PyResult<a
     Ok(airlight::Image { width: w as u32, height: h as u32, pixels })
 }
 
+/// Refuses an image with pixels that are not finite numbers, as `airlight
+/// compare` does: the measures over them would be NaN or infinite.
+fn finite(image: &airlight::Image, what: &str) -> PyResult<()> {
+    let mut broken = image.pixels.iter().enumerate().filter(|(_, p)| !p.is_finite());
+    let Some((first, p)) = broken.next() else {
+        return Ok(());
+    };
+    let count = 1 + broken.count();
+    let w = image.width.max(1) as usize;
+    Err(PyValueError::new_err(format!(
+        "{what} has {count} pixel{} that {} not finite numbers (NaN or infinite), the first at (x {}, y {}): {} {} {}; \
+         the measures would be meaningless",
+        if count == 1 { "" } else { "s" },
+        if count == 1 { "is" } else { "are" },
+        first % w,
+        first / w,
+        p.x,
+        p.y,
+        p.z
+    )))
+}
+
 /// Compares `image` against `reference` (arrays of shape (H, W, 3)) with
 /// the figures `airlight compare` prints.
 #[pyfunction]
@@ -117,6 +143,8 @@ fn compare(
 ) -> PyResult<Comparison> {
     guard(|| {
         let (a, b) = (self::image(&image, "image")?, self::image(&reference, "reference")?);
+        finite(&a, "image")?;
+        finite(&b, "reference")?;
         let e = airlight::film::compare(&a, &b).ok_or_else(|| {
             PyValueError::new_err(format!(
                 "the images differ in size: {}×{} and {}×{}",

@@ -60,11 +60,18 @@ fn type_name(v: &Bound<'_, PyAny>) -> String {
 }
 
 fn boolean(key: &str, v: &Bound<'_, PyAny>) -> PyResult<bool> {
-    // NumPy's bool_ is not a bool, but says what it is through __bool__.
-    if v.is_instance_of::<PyBool>() || type_name(v) == "bool_" {
+    // NumPy's bool (`bool_` before NumPy 2) is not a Python bool, but says
+    // what it is through __bool__.
+    if v.is_instance_of::<PyBool>() || is_numpy_bool(v) {
         return v.is_truthy();
     }
     Err(PyTypeError::new_err(format!("{key} must be True or False, got {}", type_name(v))))
+}
+
+fn is_numpy_bool(v: &Bound<'_, PyAny>) -> bool {
+    let t = v.get_type();
+    let module = t.module().map(|m| m.to_string()).unwrap_or_default();
+    module == "numpy" && matches!(type_name(v).as_str(), "bool" | "bool_")
 }
 
 fn number(key: &str, v: &Bound<'_, PyAny>) -> PyResult<f32> {

@@ -12,16 +12,20 @@ use crate::errors::{Origin, guard, scene_error};
 use crate::options::{self, Film};
 use crate::render::{self, Job, Output, Progress};
 use airlight::SceneFile;
-use airlight::integrator::{Integrator, IntegratorDesc, IntegratorError};
+use airlight::integrator::{Integrator, IntegratorDesc, IntegratorError, IntegratorKind};
 use airlight::light::Light;
-use airlight::scene::{RenderSettings, Scene};
+use airlight::scene::{AssetPath, RenderSettings, Scene};
 use numpy::PyArray3;
 use numpy::ndarray::Array3;
-use pyo3::exceptions::PyValueError;
+use pyo3::exceptions::{PyMemoryError, PyUserWarning, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
+
+/// Most worker threads a render starts, as `airlight render --threads`
+/// allows: spawning tens of thousands takes minutes before any work starts.
+const MAX_THREADS: i64 = 4096;
 
 /// Where the lights are: None as the file writes them (a still render),
 /// Some(t) at time t of the keyframes.
@@ -107,11 +111,20 @@ impl Shared {
 /// A scene's text and where it came from, for `with_lights` and errors.
 pub struct Source {
     pub text: String,
-    /// Where relative mesh paths start.
-    pub base_dir: Option<PathBuf>,
+    /// Where mesh files are found.
+    pub assets: AssetPath,
     pub origin: Origin,
     /// The file, for error messages.
     pub file: Option<PathBuf>,
+}
+
+impl Source {
+    /// Text (`loads`, dicts): meshes are found in `base_dir` (None: the
+    /// current folder), then in the folders of `AIRLIGHT_ASSET_PATH`, as
+    /// the CLI finds a scene file's.
+    pub fn text(text: String, base_dir: Option<&Path>, origin: Origin) -> Source {
+        Source { text, assets: AssetPath::new(base_dir, &AssetPath::from_env()), origin, file: None }
+    }
 }
 
 /// What a scene holds, read once.
@@ -119,6 +132,9 @@ struct Summary {
     animated: bool,
     lights: usize,
     medium: bool,
+    /// Why every pixel will be black, if so: for integrators that ignore
+    /// the medium (`direct`), and for the others.
+    darkness: [Option<String>; 2],
 }
 
 /// A scene ready to render: read from a scene file (`airlight.load`), TOML
@@ -133,25 +149,31 @@ pub struct PyScene {
     time: Option<f32>,
 }
 
-/// Reads a scene; the GIL is released meanwhile (meshes may be large).
+/// Reads a scene from its text; the GIL is released meanwhile (meshes may
+/// be large).
 pub fn read(py: Python<'_>, source: Source) -> PyResult<PyScene> {
-    let parsed = py.detach(|| {
-        SceneFile::from_toml_str(&source.text, source.base_dir.as_deref()).map_err(|e| match &source.file {
-            Some(file) => e.in_file(file),
-            None => e,
-        })
-    });
-    let SceneFile { scene, integrator } = parsed.map_err(|e| scene_error(py, &e, &source.origin, &source.text))?;
-    let summary =
-        Summary { animated: scene.is_animated(), lights: scene.lights().len(), medium: scene.medium().is_some() };
-    Ok(PyScene {
+    let parsed = py.detach(|| SceneFile::from_toml_with(&source.text, &source.assets));
+    let file = parsed.map_err(|e| scene_error(py, &e, &source.origin, &source.text))?;
+    Ok(new_scene(file, source))
+}
+
+/// The Python scene of a scene file read from `source`.
+pub fn new_scene(file: SceneFile, source: Source) -> PyScene {
+    let SceneFile { scene, integrator } = file;
+    let summary = Summary {
+        animated: scene.is_animated(),
+        lights: scene.lights().len(),
+        medium: scene.medium().is_some(),
+        darkness: [scene.darkness(false), scene.darkness(true)],
+    };
+    PyScene {
         settings: scene.settings().clone(),
         integrator,
         shared: Arc::new(Mutex::new(Shared::new(scene))),
         source: Arc::new(source),
         summary: Arc::new(summary),
         time: None,
-    })
+    }
 }
 
 /// A scene from dicts: written as TOML and read as a file would be.
@@ -159,7 +181,7 @@ pub fn from_dict(py: Python<'_>, scene: &Bound<'_, PyAny>, base_dir: Option<Path
     let table = crate::dict::table(scene, "scene")?;
     let text =
         toml::to_string(&table).map_err(|e| PyValueError::new_err(format!("cannot write the scene as TOML: {e}")))?;
-    read(py, Source { text, base_dir, origin: Origin::Dict, file: None })
+    read(py, Source::text(text, base_dir.as_deref(), Origin::Dict))
 }
 
 impl PyScene {
@@ -200,6 +222,7 @@ impl PyScene {
         self.settings.width
     }
 
+    /// Image height in pixels (the file's; `render(height=...)` overrides it).
     #[getter]
     fn height(&self) -> u32 {
         self.settings.height
@@ -211,6 +234,7 @@ impl PyScene {
         self.settings.spp
     }
 
+    /// The seed of the scene's random numbers; `render(seed=...)` overrides it.
     #[getter]
     fn seed(&self) -> u64 {
         self.settings.seed
@@ -239,6 +263,12 @@ impl PyScene {
     #[getter]
     fn toml(&self) -> &str {
         &self.source.text
+    }
+
+    /// The scene file read (`load`), else None.
+    #[getter]
+    fn path(&self) -> Option<&Path> {
+        self.source.file.as_deref()
     }
 
     fn __repr__(&self) -> String {
@@ -287,8 +317,8 @@ impl PyScene {
             table.insert("lights".into(), crate::dict::array(lights, "lights")?);
             let text = toml::to_string(&table)
                 .map_err(|e| PyValueError::new_err(format!("cannot write the scene as TOML: {e}")))?;
-            let base_dir = self.source.base_dir.clone();
-            read(py, Source { text, base_dir, origin: Origin::Dict, file: None })
+            let assets = self.source.assets.clone();
+            read(py, Source { text, assets, origin: Origin::Dict, file: None })
         })
     }
 
@@ -320,8 +350,12 @@ impl PyScene {
             let desc = options::integrator(self.integrator, integrator, options)?;
             let threads = match threads {
                 None => 0,
-                Some(n) if n >= 1 => n as usize,
-                Some(n) => return Err(PyValueError::new_err(format!("threads must be at least 1, got {n}"))),
+                Some(n) if (1..=MAX_THREADS).contains(&n) => n as usize,
+                Some(n) => {
+                    return Err(PyValueError::new_err(format!(
+                        "threads must be an integer from 1 to {MAX_THREADS}, got {n}"
+                    )));
+                }
             };
             let spp = settings.spp as u64;
             let samples = match shard {
@@ -336,6 +370,17 @@ impl PyScene {
                 }
                 Some((k, n)) => airlight::film::partial::piece(spp, k as u64, n as u64),
             };
+            // As the CLI does before it renders: an image too large for
+            // memory is refused, a scene that can only be black is warned of.
+            let pixels = settings.width as u64 * settings.height as u64;
+            let what = format!("a {}×{} render", settings.width, settings.height);
+            airlight::memory::check(what, airlight::memory::render_bytes(pixels, aovs))
+                .map_err(|e| PyMemoryError::new_err(format!("{e}: make the image smaller (width=, height=)")))?;
+            let sees_medium = desc.kind != IntegratorKind::Direct;
+            if let Some(why) = &self.summary.darkness[sees_medium as usize] {
+                let message = std::ffi::CString::new(why.as_str()).unwrap_or_default();
+                PyErr::warn(py, &py.get_type::<PyUserWarning>(), &message, 1)?;
+            }
             let label =
                 format!("{} {}×{} {} spp", desc.kind, settings.width, settings.height, samples.end - samples.start);
             let progress = Progress::from_arg(py, progress, &label)?;

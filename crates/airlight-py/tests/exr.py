@@ -36,7 +36,8 @@ def _unzip(raw, size):
 
 def read_exr(path):
     """The R, G, B channels as a float32 array (height, width, 3)."""
-    data = open(path, "rb").read()
+    with open(path, "rb") as f:
+        data = f.read()
     assert data[:4] == b"\x76\x2f\x31\x01", "not an EXR file"
     pos, header = 8, {}
     while data[pos] != 0:

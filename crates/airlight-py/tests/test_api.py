@@ -50,7 +50,7 @@ def test_shards_are_means_that_combine_into_the_whole_render(fog):
     for k in range(3):
         start, stop = airlight.shard_samples(10, k, 3)
         parts.append((stop - start) * fog.render(**SMALL, spp=10, shard=(k, 3)).astype(np.float64))
-    assert [airlight.shard_samples(10, k, 3) for k in range(3)] == [(0, 3), (3, 6), (6, 10)]
+    assert [airlight.shard_samples(10, k, 3) for k in range(3)] == [(0, 4), (4, 7), (7, 10)]
     np.testing.assert_allclose(sum(parts) / 10, whole, rtol=1e-5, atol=1e-7)
 
 
@@ -90,7 +90,8 @@ def test_with_lights_replaces_the_lights():
     np.testing.assert_allclose(image, 4 * scene.render(**SMALL), rtol=1e-4, atol=1e-6)
     with pytest.raises(airlight.SceneError, match=r"lights\[0\]"):
         scene.with_lights([{"type": "point", "position": [0, 1, 0], "intensity": -1}])
-    assert scene.with_lights([]).render(**SMALL, integrator="direct").max() == 0
+    with pytest.warns(UserWarning, match="no lights"):
+        assert scene.with_lights([]).render(**SMALL, integrator="direct").max() == 0
 
 
 def test_save_and_read_exr_round_trip(tmp_path, fog):
@@ -114,3 +115,54 @@ def test_compare_takes_any_float_arrays():
     assert c.rel_rmse == pytest.approx(1.0)
     with pytest.raises(ValueError, match="differ in size: 3×2 and 2×3"):
         airlight.compare(a, np.ones((3, 2, 3)))
+
+
+def test_compare_refuses_pixels_that_are_not_numbers_as_the_cli_does():
+    a = np.ones((2, 3, 3), dtype=np.float32)
+    b = a.copy()
+    b[1, 2] = [np.nan, 0, np.inf]
+    b[0, 1, 0] = np.nan
+    with pytest.raises(ValueError, match=r"^reference has 2 pixels that are not finite .* first at \(x 1, y 0\): NaN 1 1"):
+        airlight.compare(a, b)
+
+
+def test_a_scene_file_knows_its_path_and_text(fog):
+    assert fog.path == SCENES / "spheres_point_fog.toml"
+    assert fog.toml == (SCENES / "spheres_point_fog.toml").read_text()
+    assert airlight.loads(fog.toml).path is None
+
+
+def test_progress_true_shows_a_tqdm_bar(fog, capsys):
+    fog.render(**SMALL, spp=2, progress=True)
+    err = capsys.readouterr().err
+    # tqdm's last line: the whole count, with the label render() gives it.
+    assert "raymarch 24×16 2 spp" in err and "100%" in err
+
+
+def test_a_scene_that_can_only_be_black_is_warned_of_as_the_cli_does(cli, tmp_path):
+    scene = {
+        "render": {"width": 8, "height": 6},
+        "materials": {"white": {"albedo": 0.8}},
+        "objects": [{"type": "sphere", "center": [0, 1, 0], "radius": 1, "material": "white"}],
+    }
+    path = tmp_path / "dark.toml"
+    path.write_text(airlight.Scene(scene).toml)
+    warning = cli("render", path, "-o", tmp_path / "dark.png", "--quiet").stderr.strip()
+    assert warning.startswith("warning: the scene has no lights")
+    with pytest.warns(UserWarning) as caught:
+        image = airlight.Scene(scene).render()
+    assert [str(w.message) for w in caught] == [warning.removeprefix("warning: ")]
+    assert image.max() == 0
+
+
+def test_a_render_too_large_for_memory_is_refused_with_the_cli_message(cli, monkeypatch, tmp_path):
+    monkeypatch.setenv("AIRLIGHT_MEMORY_LIMIT", "1M")
+    p = cli("render", SCENES / "spheres_point_fog.toml", "-o", tmp_path / "x.png", check=False)
+    assert p.returncode != 0
+    expected = p.stderr.strip().removeprefix("error: ")
+    assert expected.endswith(": make the image smaller (--width, --height)")
+    with pytest.raises(MemoryError) as e:
+        airlight.load(SCENES / "spheres_point_fog.toml").render()
+    assert str(e.value) == expected.replace("(--width, --height)", "(width=, height=)")
+    # A smaller image fits.
+    assert airlight.load(SCENES / "spheres_point_fog.toml").render(**SMALL).shape == (16, 24, 3)

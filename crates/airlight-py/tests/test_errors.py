@@ -122,7 +122,7 @@ def test_option_errors_are_the_scene_file_messages(cli, tmp_path):
         scene.render(jitter=1)
     with pytest.raises(ValueError, match="^spp must be an integer from 1 to 16777216, got 0$"):
         scene.render(spp=0)
-    with pytest.raises(ValueError, match="threads must be at least 1"):
+    with pytest.raises(ValueError, match="^threads must be an integer from 1 to 4096, got 0$"):
         scene.render(threads=0)
     with pytest.raises(ValueError, match="at most 2 shards"):
         scene.render(spp=2, shard=(0, 3))

@@ -119,17 +119,16 @@ CHILD = textwrap.dedent(
 def test_sigint_stops_a_long_render_within_a_second(tmp_path):
     script = tmp_path / "child.py"
     script.write_text(CHILD)
-    child = subprocess.Popen(
-        [sys.executable, str(script), str(SCENES / "four_lights.toml")], stdout=subprocess.PIPE, text=True
-    )
-    try:
-        assert child.stdout.readline().strip() == "rendering"
-        time.sleep(0.5)
-        sent = time.monotonic()
-        os.kill(child.pid, signal.SIGINT)
-        assert child.stdout.readline().strip() == "interrupted"
-        assert time.monotonic() - sent < 1.0, time.monotonic() - sent
-        assert child.stdout.readline().strip() == "again (6, 8, 3)"
-        assert child.wait(timeout=10) == 0
-    finally:
-        child.kill()
+    command = [sys.executable, str(script), str(SCENES / "four_lights.toml")]
+    with subprocess.Popen(command, stdout=subprocess.PIPE, text=True) as child:
+        try:
+            assert child.stdout.readline().strip() == "rendering"
+            time.sleep(0.5)
+            sent = time.monotonic()
+            os.kill(child.pid, signal.SIGINT)
+            assert child.stdout.readline().strip() == "interrupted"
+            assert time.monotonic() - sent < 1.0, time.monotonic() - sent
+            assert child.stdout.readline().strip() == "again (6, 8, 3)"
+            assert child.wait(timeout=10) == 0
+        finally:
+            child.kill()
