@@ -2,7 +2,8 @@
 
 The binary is $AIRLIGHT_BIN, else target/release/airlight under
 $CARGO_TARGET_DIR or the repository. Tests that need it skip without it,
-except under AIRLIGHT_CI=1 (as .ci/run sets), where a skip is a failure.
+except under AIRLIGHT_CI=1 (as .ci/run and crates/airlight-cli/tests/python.rs
+set), where every skip is a failure.
 """
 
 import os
@@ -47,3 +48,13 @@ def cli(airlight_bin):
         return p
 
     return run
+
+
+@pytest.hookimpl(hookwrapper=True)
+def pytest_runtest_makereport(item, call):
+    """Under AIRLIGHT_CI=1 a skipped test is reported as failed."""
+    outcome = yield
+    report = outcome.get_result()
+    if report.skipped and os.environ.get("AIRLIGHT_CI") == "1":
+        report.outcome = "failed"
+        report.longrepr = f"AIRLIGHT_CI=1: skipped, which CI must not do: {report.longrepr}"
