@@ -323,9 +323,30 @@ impl PyScene {
     }
 
     /// Renders the scene; returns linear RGB as a float32 array (height,
-    /// width, 3), or with `aovs=True` a dict of named arrays: `color` and
-    /// `variance` (the estimated variance of each pixel's mean, per channel).
-    /// See the type stubs for every argument.
+    /// width, 3), the same pixels `airlight render` writes to an EXR.
+    ///
+    /// - `integrator`: direct, raymarch, analytic, stochastic, path or
+    ///   radiosity (default: the scene's).
+    /// - `spp`, `seed`, `width`, `height`: override the scene's `[render]`.
+    /// - `threads`: worker threads (default: every core); the image does
+    ///   not depend on it.
+    /// - `shard=(k, n)`: only the k-th of n ranges of each pixel's samples
+    ///   (`shard_samples`), as `airlight render --shard k/n`; the result is
+    ///   their mean.
+    /// - `progress`: a callable `f(done, total)` (pixel samples), a tqdm
+    ///   bar, or True for a new tqdm bar; called on this thread at most
+    ///   every 0.1 s. An exception it raises stops the render.
+    /// - `aovs=True`: a dict of named arrays instead, `color` and
+    ///   `variance` (the estimated variance of each pixel's mean).
+    /// - Other keywords are integrator options by their scene-file names:
+    ///   steps, jitter, shadows, light_steps, light_quadrature, sampling,
+    ///   stratify, max_depth, bounces, patch_size, link_threshold; checked
+    ///   as the file checks them (`IntegratorError`).
+    ///
+    /// The GIL is released while rendering; Ctrl-C (looked for every 50 ms)
+    /// stops the render and raises KeyboardInterrupt. An image too large
+    /// for the memory left raises MemoryError; a scene that can only be
+    /// black gives a UserWarning, as the CLI warns.
     #[pyo3(signature = (
         integrator=None, *, spp=None, seed=None, width=None, height=None, threads=None,
         shard=None, progress=None, aovs=false, **options
