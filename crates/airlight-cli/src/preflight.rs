@@ -25,10 +25,14 @@ pub fn render_memory(scene: &Scene, progressive: bool) -> Result<(), String> {
         .map_err(|e| format!("{e}: make the image smaller (--width, --height)"))
 }
 
-/// Prints a warning when every frame of `scene` will be black.
+/// Prints a warning when every frame of `scene` will be black, and one for
+/// each thing the scene asked for that Airlight does not do yet.
 pub fn warn_if_dark(scene: &Scene, sees_medium: bool) {
     if let Some(why) = scene.darkness(sees_medium) {
         eprintln!("warning: {why}");
+    }
+    for note in scene.notes() {
+        eprintln!("warning: {note}");
     }
 }
 

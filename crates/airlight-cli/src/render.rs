@@ -3,10 +3,12 @@
 //! render (a range of samples, a band of rows, one frame) for a render farm
 //! to merge.
 
+use crate::aovs::Layers;
 use crate::load;
 use crate::preflight::Forecast;
 use crate::progress::Progress;
 use airlight::SceneFile;
+use airlight::aov::Aov;
 use airlight::film::Image;
 use airlight::film::partial::{Partial, PartialHeader, piece};
 use airlight::integrator::analytic::LightQuadrature;
@@ -99,15 +101,22 @@ pub struct RenderArgs {
     /// Worker threads (default: all cores). The image does not depend on it.
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=crate::preflight::MAX_THREADS as i64))]
     threads: Option<u32>,
+    /// Also write, as layers of each .exr output, what the camera's first
+    /// hits are: a comma-separated list of albedo, normal, depth and
+    /// variance (variance implies --progressive)
+    #[arg(long, value_name = "LIST", value_parser = crate::aovs::parse_list)]
+    aov: Option<crate::aovs::AovList>,
     /// No progress bar or summary.
     #[arg(long, short)]
     quiet: bool,
 }
 
-/// Where one frame goes: its images and, on request, its variance.
+/// Where one frame goes: its images and, on request, its variance and
+/// the layers its EXR images carry.
 struct FrameOutputs {
     images: Vec<PathBuf>,
     variance: Option<PathBuf>,
+    layers: Layers,
 }
 
 /// What one `render` command computes: which frames, which samples of
@@ -190,7 +199,10 @@ pub fn render(args: RenderArgs) -> Result<(), String> {
     let (SceneFile { mut scene, integrator: desc }, plan, outputs) = prepare(&args)?;
     // Of the scene as resolved, before any frame moves its lights.
     let fingerprint = airlight::fingerprint(&scene, &desc);
-    let progressive = args.progressive || args.target_error.is_some() || args.variance.is_some();
+    let aovs = args.aov.clone().map(|list| list.0).unwrap_or_default();
+    let progressive =
+        args.progressive || args.target_error.is_some() || args.variance.is_some() || aovs.contains(&Aov::Variance);
+    crate::aovs::check(&aovs, &outputs, plan.partial)?;
     let (files, variance) = (scene.files(), args.variance.as_deref());
     crate::outputs::check_render(args.scene.as_deref(), files, &outputs, variance, args.frames)?;
     crate::preflight::render_memory(&scene, progressive)?;
@@ -225,9 +237,14 @@ pub fn render(args: RenderArgs) -> Result<(), String> {
                 FrameOutputs {
                     images: outputs.iter().map(|p| numbered(p, k)).collect(),
                     variance: args.variance.as_deref().map(|p| numbered(p, k)),
+                    layers: Layers::none(),
                 }
             }
-            None => FrameOutputs { images: outputs.clone(), variance: args.variance.clone() },
+            None => FrameOutputs { images: outputs.clone(), variance: args.variance.clone(), layers: Layers::none() },
+        };
+        let outputs = FrameOutputs {
+            layers: Layers::of_frame(&scene, integrator.as_ref(), &pool, &aovs, plan.samples.clone()),
+            ..outputs
         };
         let frame_label = frame.map(|(k, n)| format!(" frame {k} of {n}")).unwrap_or_default();
         let label = format!("{}{frame_label}", desc.kind);
@@ -357,10 +374,14 @@ pub fn numbered(path: &Path, frame: u32) -> PathBuf {
     path.with_file_name(name)
 }
 
-fn write_images(scene: &Scene, image: &Image, outputs: &[PathBuf]) -> Result<(), String> {
+fn write_images(scene: &Scene, image: &Image, outputs: &FrameOutputs, variance: Option<&Image>) -> Result<(), String> {
     let s = scene.settings();
-    for out in outputs {
-        image.save_with(out, s.exposure, s.tonemap).map_err(|e| format!("cannot write `{}`: {e}", out.display()))?;
+    for out in &outputs.images {
+        let written = match outputs.layers.channels(variance) {
+            Some(channels) if crate::aovs::is_exr(out) => image.save_exr_with_channels(out, &channels),
+            _ => image.save_with(out, s.exposure, s.tonemap),
+        };
+        written.map_err(|e| format!("cannot write `{}`: {e}", out.display()))?;
     }
     Ok(())
 }
@@ -379,7 +400,7 @@ fn render_once(
     let inc = |n: u64| progress.inc(n);
     let observer = RenderObserver { progress: Some(&inc), cancel: None };
     let image = pool.install(|| airlight::render(scene, integrator, &observer));
-    write_images(scene, &image, &outputs.images)?;
+    write_images(scene, &image, outputs, None)?;
     Ok(String::new())
 }
 
@@ -465,7 +486,8 @@ fn render_progressive(
     let mut error = progressive.estimated_relative_error();
     if progressive.samples() > 0 && (progressive.finished() || target_error.is_some_and(|target| error < target)) {
         // Stopped after its last pass, before it tidied up: the images again.
-        write_images(scene, &progressive.image(), &outputs.images)?;
+        let variance = outputs.layers.wants_variance().then(|| progressive.variance());
+        write_images(scene, &progressive.image(), outputs, variance.as_ref())?;
     }
     while !progressive.finished() && !target_error.is_some_and(|target| error < target) {
         let inc = |n: u64| progress.inc(n);
@@ -480,7 +502,8 @@ fn render_progressive(
             s.spp,
             format_error(error),
         ));
-        write_images(scene, &progressive.image(), &outputs.images)?;
+        let variance = outputs.layers.wants_variance().then(|| progressive.variance());
+        write_images(scene, &progressive.image(), outputs, variance.as_ref())?;
         // The variance is known from the second sample on (EXR: linear, the
         // tone map is not applied).
         if let Some(path) = outputs.variance.as_ref().filter(|_| progressive.samples() >= 2) {

@@ -28,6 +28,7 @@
 //! [`SceneFile::load`]. The file format, units and conventions are in
 //! docs/scene-format.md.
 
+pub mod aov;
 pub mod camera;
 pub mod film;
 pub mod geometry;

@@ -101,6 +101,32 @@ impl Image {
         write_atomically(path, &bytes)
     }
 
+    /// Writes the image as an EXR with more channels beside R, G, B (each
+    /// named, e.g. `albedo.R`, `N.X`, `Z`: layers of a multi-layer EXR, as
+    /// compositors read them), whole or not at all.
+    pub fn save_exr_with_channels(&self, path: &Path, extra: &[(&str, Vec<f32>)]) -> io::Result<()> {
+        use exr::prelude::*;
+        let count = self.pixels.len();
+        if let Some((name, _)) = extra.iter().find(|(_, values)| values.len() != count) {
+            return Err(io::Error::other(format!("channel {name} does not have one value per pixel")));
+        }
+        let mut list: Vec<AnyChannel<FlatSamples>> = ["R", "G", "B"]
+            .iter()
+            .enumerate()
+            .map(|(c, name)| AnyChannel::new(*name, FlatSamples::F32(self.pixels.iter().map(|p| p[c]).collect())))
+            .collect();
+        for (name, values) in extra {
+            list.push(AnyChannel::new(*name, FlatSamples::F32(values.clone())));
+        }
+        let encoding =
+            Encoding { compression: Compression::ZIP16, blocks: Blocks::ScanLines, line_order: LineOrder::Increasing };
+        let size = (self.width as usize, self.height as usize);
+        let layer = Layer::new(size, LayerAttributes::default(), encoding, AnyChannels::sort(list.into()));
+        let mut out = io::Cursor::new(Vec::new());
+        exr::prelude::Image::from_layer(layer).write().to_buffered(&mut out).map_err(io::Error::other)?;
+        write_atomically(path, &out.into_inner())
+    }
+
     fn encode_exr(&self) -> io::Result<Vec<u8>> {
         use exr::prelude::*;
         let (w, h) = (self.width as usize, self.height as usize);

@@ -79,6 +79,7 @@ impl Light {
             Light::Point { position, .. } | Light::Spot { position, .. } => Some(position),
             Light::Sphere { center, .. } => Some(center),
             Light::Quad { corner, edge_u, edge_v, .. } => Some(corner + 0.5 * (edge_u + edge_v)),
+            Light::Triangle { a, edge_1, edge_2, .. } => Some(a + (edge_1 + edge_2) / 3.0),
             Light::Line { start, end, .. } => Some(0.5 * (start + end)),
             Light::Volume { shape: LightVolume::Box { min, max }, .. } => Some(0.5 * (min + max)),
             Light::Volume { shape: LightVolume::Sphere { center, .. }, .. } => Some(center),
@@ -93,6 +94,7 @@ impl Light {
             Light::Point { position, .. } | Light::Spot { position, .. } => *position = p,
             Light::Sphere { center, .. } => *center = p,
             Light::Quad { corner, edge_u, edge_v, .. } => *corner = p - 0.5 * (*edge_u + *edge_v),
+            Light::Triangle { a, edge_1, edge_2, .. } => *a = p - (*edge_1 + *edge_2) / 3.0,
             Light::Line { start, end, .. } => {
                 let half = 0.5 * (*end - *start);
                 (*start, *end) = (p - half, p + half);

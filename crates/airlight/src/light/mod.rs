@@ -1,5 +1,5 @@
 //! Lights, in the units of docs/scene-format.md: point and spot `intensity` in W/sr,
-//! distant `irradiance` on a facing surface, sphere and quad `radiance`, line
+//! distant `irradiance` on a facing surface, sphere, quad and triangle `radiance`, line
 //! `intensity` per unit length (W/(sr·m)).
 
 mod attenuation;
@@ -54,6 +54,16 @@ pub enum Light {
         corner: Vec3,
         edge_u: Vec3,
         edge_v: Vec3,
+        radiance: Rgb,
+    },
+    /// An emitting triangle `a`, `a + edge_1`, `a + edge_2` (one of an
+    /// emissive mesh's): emits `radiance` on the side of
+    /// normalize(edge_1 × edge_2) only, the side its vertices wind
+    /// counter-clockwise around, as OBJ and glTF front faces do.
+    Triangle {
+        a: Vec3,
+        edge_1: Vec3,
+        edge_2: Vec3,
         radiance: Rgb,
     },
     /// A glowing segment, a neon tube too thin to see or hit: each element
@@ -169,6 +179,12 @@ impl Light {
         Light::Quad { corner, edge_u, edge_v, radiance }
     }
 
+    /// An emitting triangle with vertices `a`, `b`, `c` (counter-clockwise
+    /// seen from the side it lights).
+    pub fn triangle(a: Vec3, b: Vec3, c: Vec3, radiance: Rgb) -> Self {
+        Light::Triangle { a, edge_1: b - a, edge_2: c - a, radiance }
+    }
+
     pub fn line(start: Vec3, end: Vec3, intensity: Rgb) -> Self {
         Light::Line { start, end, intensity }
     }
@@ -202,6 +218,10 @@ impl Light {
             Light::Quad { corner, edge_u, edge_v, .. } => {
                 let radius = (edge_u.cross(edge_v).length() / std::f32::consts::PI).sqrt();
                 Some((corner + 0.5 * (edge_u + edge_v), spread(radius)))
+            }
+            Light::Triangle { a, edge_1, edge_2, .. } => {
+                let radius = (0.5 * edge_1.cross(edge_2).length() / std::f32::consts::PI).sqrt();
+                Some((a + (edge_1 + edge_2) / 3.0, spread(radius)))
             }
             Light::Line { start, end, .. } => Some((0.5 * (start + end), spread(0.5 * (end - start).length()))),
             Light::Distant { .. } => None,
@@ -277,19 +297,14 @@ impl Light {
                 })
             }
             Light::Quad { corner, edge_u, edge_v, radiance } => {
-                let x = corner + edge_u * u.x + edge_v * u.y;
-                let to = x - p;
-                let d2 = to.length_squared();
-                let distance = d2.sqrt();
-                let wi = to / distance;
-                let normal_area = edge_u.cross(edge_v);
-                let area = normal_area.length();
-                let cos_light = -wi.dot(normal_area) / area;
-                if cos_light <= 0.0 || d2 == 0.0 {
-                    return None;
-                }
-                let pdf = d2 / (area * cos_light);
-                Some(LightSample { wi, distance, weight: radiance / pdf, pdf })
+                area_sample(corner + edge_u * u.x + edge_v * u.y, edge_u.cross(edge_v), radiance, p)
+            }
+            Light::Triangle { a, edge_1, edge_2, radiance } => {
+                // Uniform by area: √u₀ is the distance fraction from `a`
+                // toward the far edge, u₁ the place along it.
+                let s = u.x.sqrt();
+                let x = a + edge_1 * (s * (1.0 - u.y)) + edge_2 * (s * u.y);
+                area_sample(x, 0.5 * edge_1.cross(edge_2), radiance, p)
             }
             // Two numbers given: the third is a hash of them (volume.rs).
             Light::Volume { .. } => self.sample3(p, u.extend(third_dimension(u))),
@@ -311,22 +326,22 @@ impl Light {
                 let one_minus_cos = sin2 / (1.0 + (1.0 - sin2).max(0.0).sqrt());
                 1.0 / (2.0 * std::f32::consts::PI * one_minus_cos)
             }
-            Light::Quad { edge_u, edge_v, .. } => {
-                let normal_area = edge_u.cross(edge_v);
-                let area = normal_area.length();
-                let cos_light = -wi.dot(normal_area) / area;
-                if cos_light <= 0.0 { 0.0 } else { t * t / (area * cos_light) }
-            }
+            Light::Quad { edge_u, edge_v, .. } => area_pdf(edge_u.cross(edge_v), wi, t),
+            Light::Triangle { edge_1, edge_2, .. } => area_pdf(0.5 * edge_1.cross(edge_2), wi, t),
             _ => 0.0,
         }
     }
 
-    /// The surface the camera sees and shadows meet, for sphere and quad
-    /// lights; other lights have none (points, directions, glowing air).
+    /// The surface the camera sees and shadows meet, for sphere, quad and
+    /// triangle lights; other lights have none (points, directions, glowing air).
     pub fn surface(&self) -> Option<crate::geometry::Shape> {
         match *self {
             Light::Sphere { center, radius, .. } => Some(crate::geometry::Shape::sphere(center, radius)),
             Light::Quad { corner, edge_u, edge_v, .. } => Some(crate::geometry::Shape::quad(corner, edge_u, edge_v)),
+            Light::Triangle { a, edge_1, edge_2, .. } => Some(crate::geometry::Shape::Mesh {
+                positions: vec![a, a + edge_1, a + edge_2],
+                triangles: vec![[0, 1, 2]],
+            }),
             _ => None,
         }
     }
@@ -336,7 +351,7 @@ impl Light {
     pub fn emitted(&self, n: Vec3, dir: Vec3) -> Rgb {
         match *self {
             Light::Sphere { radiance, .. } => radiance,
-            Light::Quad { radiance, .. } if n.dot(dir) < 0.0 => radiance,
+            Light::Quad { radiance, .. } | Light::Triangle { radiance, .. } if n.dot(dir) < 0.0 => radiance,
             _ => Rgb::ZERO,
         }
     }
@@ -362,6 +377,26 @@ fn point_falloff(position: Vec3, p: Vec3, a: &Attenuation) -> Option<(Vec3, f32,
         }
     };
     Some((to / distance, distance, falloff))
+}
+
+/// The sample of a one-sided area light (normal_area: its normal times its
+/// area) at its point `x`, drawn uniformly by area, seen from `p`: the pdf
+/// 1/area turned into solid angle, d²/(area·cos θ_light). None behind it.
+fn area_sample(x: Vec3, normal_area: Vec3, radiance: Rgb, p: Vec3) -> Option<LightSample> {
+    let to = x - p;
+    let d2 = to.length_squared();
+    let distance = d2.sqrt();
+    let wi = to / distance;
+    let pdf = area_pdf(normal_area, wi, distance);
+    (pdf > 0.0 && pdf.is_finite()).then(|| LightSample { wi, distance, weight: radiance / pdf, pdf })
+}
+
+/// Solid-angle pdf of direction `wi` toward a one-sided area light sampled
+/// uniformly by area, met at distance `t`; 0 from behind.
+fn area_pdf(normal_area: Vec3, wi: Vec3, t: f32) -> f32 {
+    let area = normal_area.length();
+    let cos_light = -wi.dot(normal_area) / area;
+    if cos_light <= 0.0 { 0.0 } else { t * t / (area * cos_light) }
 }
 
 /// Samples a sphere light over the cone of directions it subtends from `p`

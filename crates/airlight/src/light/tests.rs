@@ -48,6 +48,61 @@ fn quad_light_irradiance_matches_lambert_closed_form() {
 }
 
 #[test]
+fn triangle_light_irradiance_matches_lambert_closed_form() {
+    // A slanted triangle above the point, wound to face it, near and far.
+    for (lift, tolerance) in [(0.6f32, 0.01), (4.0, 0.002)] {
+        let (a, b, c) =
+            (Vec3::new(-0.7, lift, -0.2), Vec3::new(0.2, lift + 0.5, 0.9), Vec3::new(0.9, lift - 0.1, -0.4));
+        let light = Light::triangle(a, c, b, Rgb::splat(2.5));
+        let Light::Triangle { edge_1, edge_2, .. } = light else { unreachable!() };
+        assert!(edge_1.cross(edge_2).y < 0.0, "faces down");
+        let exact = polygon_irradiance(&[a, c, b].map(|v| v.as_dvec3()), 2.5, glam::DVec3::Y);
+        let est = estimated_irradiance(&light, Vec3::ZERO, Vec3::Y, 64);
+        assert!((est / exact - 1.0).abs() < tolerance, "lift {lift}: estimate {est} exact {exact}");
+        // Wound the other way it faces away: no light.
+        let back = Light::triangle(a, b, c, Rgb::splat(2.5));
+        assert_eq!(estimated_irradiance(&back, Vec3::ZERO, Vec3::Y, 8), 0.0);
+    }
+}
+
+#[test]
+fn two_triangles_give_the_light_of_their_quad() {
+    let (corner, eu, ev) = (Vec3::new(-0.5, 2.0, -0.3), Vec3::new(1.2, 0.0, 0.0), Vec3::new(0.0, 0.3, 0.8));
+    let quad = Light::quad(corner, eu, ev, Rgb::splat(4.0));
+    let halves = [
+        Light::triangle(corner, corner + eu, corner + eu + ev, Rgb::splat(4.0)),
+        Light::triangle(corner, corner + eu + ev, corner + ev, Rgb::splat(4.0)),
+    ];
+    for (p, n) in [(Vec3::ZERO, Vec3::Y), (Vec3::new(1.5, 0.5, -1.0), Vec3::new(-0.5, 1.0, 0.6).normalize())] {
+        let of_quad = estimated_irradiance(&quad, p, n, 64);
+        let of_triangles: f64 = halves.iter().map(|t| estimated_irradiance(t, p, n, 64)).sum();
+        assert!((of_triangles / of_quad - 1.0).abs() < 0.003, "{of_triangles} vs {of_quad}");
+    }
+}
+
+#[test]
+fn triangle_light_pdf_is_the_pdf_it_samples_with() {
+    let light = Light::triangle(Vec3::new(0.0, 1.0, 0.0), Vec3::new(1.0, 1.5, 0.0), Vec3::new(0.0, 1.2, 1.0), Rgb::ONE);
+    let p = Vec3::new(0.3, -0.5, 0.2);
+    let mut seen = 0;
+    for i in 0..16 {
+        let u = Vec2::new((i as f32 + 0.5) / 16.0, ((i * 7) % 16) as f32 / 16.0 + 0.03);
+        if let Some(s) = light.sample(p, u) {
+            let pdf = light.pdf(p, s.wi, s.distance);
+            assert!((pdf / s.pdf - 1.0).abs() < 1e-4, "{pdf} vs {}", s.pdf);
+            // The sampled point lies on the light's surface.
+            let surface = light.surface().unwrap();
+            let crate::geometry::Shape::Mesh { positions, .. } = surface else { unreachable!() };
+            let (a, e1, e2) = (positions[0], positions[1] - positions[0], positions[2] - positions[0]);
+            let t = crate::geometry::intersect_triangle(a, e1, e2, p, s.wi, 0.0, f32::INFINITY);
+            assert!((t / s.distance - 1.0).abs() < 1e-4, "hit at {t}, sampled at {}", s.distance);
+            seen += 1;
+        }
+    }
+    assert!(seen > 0, "the light faces p but gave no sample");
+}
+
+#[test]
 fn sphere_light_irradiance_matches_closed_form() {
     // E = π L (r/D)² on a point facing the sphere's centre at distance D.
     for (radius, dist) in [(0.5f32, 3.0f32), (1.0, 1.2), (0.05, 10.0)] {

@@ -3,10 +3,12 @@
 
 use super::assets::AssetPath;
 use super::desc::*;
+use super::gltf;
 use super::limits;
 use super::{MAX_IMAGE_SIDE, MAX_SPP, RenderSettings, Scene, SceneBuilder, SceneError, desc};
 use crate::Rgb;
 use crate::geometry::Shape;
+use crate::light::Light;
 use crate::material::Material;
 use crate::medium::Medium;
 use glam::{Affine3A, Quat, Vec3};
@@ -14,6 +16,16 @@ use std::cell::{Cell, RefCell};
 use std::ops::Range;
 use std::path::PathBuf;
 use toml::Spanned;
+
+/// What one `[[objects]]` table builds: surfaces with the names of their
+/// materials, the materials it brings (an OBJ's `.mtl`), and the lights
+/// of emitting surfaces.
+#[derive(Default)]
+pub(super) struct Built {
+    pub materials: Vec<(String, Material)>,
+    pub objects: Vec<(Shape, String)>,
+    pub lights: Vec<Light>,
+}
 
 /// Parses scene file text into its description; errors name the line and
 /// column (unknown keys at the key).
@@ -35,9 +47,17 @@ pub fn build(desc: &SceneDesc, text: &str, assets: &AssetPath) -> Result<Scene, 
     // The same text parsed to a spanned document: where each key and value
     // stands, for errors found after deserializing.
     let document = toml::de::DeTable::parse(text).map(|d| d.into_inner()).unwrap_or_default();
-    let checker = Checker { text, assets, document, files: RefCell::default(), mesh_bytes: Cell::new(0) };
+    let checker = Checker {
+        text,
+        assets,
+        document,
+        files: RefCell::default(),
+        mesh_bytes: Cell::new(0),
+        notes: RefCell::default(),
+    };
     let mut scene = checker.scene(desc)?;
     scene.files = checker.files.into_inner();
+    scene.notes = checker.notes.into_inner();
     Ok(scene)
 }
 
@@ -49,6 +69,8 @@ pub(super) struct Checker<'a> {
     pub(super) files: RefCell<Vec<PathBuf>>,
     /// Memory the meshes read so far will take.
     pub(super) mesh_bytes: Cell<u64>,
+    /// What was asked for and is not done (see [`Scene::notes`]).
+    pub(super) notes: RefCell<Vec<String>>,
 }
 
 pub(super) type Result<T, E = SceneError> = std::result::Result<T, E>;
@@ -76,8 +98,26 @@ impl Checker<'_> {
     }
 
     fn scene(&self, desc: &SceneDesc) -> Result<Scene> {
-        let settings = self.settings(desc)?;
+        let mut settings = self.settings(desc)?;
+        let mut included = Vec::new();
+        for (i, include) in desc.include.iter().enumerate() {
+            included.push(self.include(i, include, desc)?);
+        }
+        // An included camera serves when the file has none; its aspect
+        // ratio sets the height when the file sets no size.
+        let included_camera = included.iter_mut().find_map(|i| i.camera.take()).filter(|_| desc.camera.is_none());
+        if let Some((_, Some(aspect))) = included_camera
+            && desc.render.width.is_none()
+            && desc.render.height.is_none()
+            && aspect.is_finite()
+            && aspect > 0.0
+        {
+            settings.height = ((settings.width as f32 / aspect).round() as u32).clamp(1, MAX_IMAGE_SIDE);
+        }
         let mut builder = SceneBuilder::new().settings(settings);
+        if let Some((camera, _)) = included_camera {
+            builder = builder.camera(camera);
+        }
         if let Some(camera) = &desc.camera {
             builder = builder.camera(self.camera(camera)?);
         }
@@ -88,8 +128,16 @@ impl Checker<'_> {
             builder = builder.material(name, self.material(name, material)?);
         }
         for (i, object) in desc.objects.iter().enumerate() {
-            let (shape, material) = self.object(i, object, desc)?;
-            builder = builder.object(shape, &material);
+            let built = self.object(i, object, desc)?;
+            builder = built.materials.into_iter().fold(builder, |b, (name, m)| b.material(&name, m));
+            builder = built.objects.into_iter().fold(builder, |b, (shape, name)| b.object(shape, &name));
+            builder = built.lights.into_iter().fold(builder, SceneBuilder::light);
+        }
+        for imported in included {
+            let built = imported.built;
+            builder = built.materials.into_iter().fold(builder, |b, (name, m)| b.material(&name, m));
+            builder = built.objects.into_iter().fold(builder, |b, (shape, name)| b.object(shape, &name));
+            builder = built.lights.into_iter().fold(builder, SceneBuilder::light);
         }
         for (i, light) in desc.lights.iter().enumerate() {
             let built = self.light(i, light)?;
@@ -280,7 +328,7 @@ impl Checker<'_> {
         })
     }
 
-    fn object(&self, index: usize, desc: &Spanned<ObjectDesc>, scene: &SceneDesc) -> Result<(Shape, String)> {
+    fn object(&self, index: usize, desc: &Spanned<ObjectDesc>, scene: &SceneDesc) -> Result<Built> {
         let span = desc.span();
         let o = desc.get_ref();
         let kind = format!("{:?}", o.kind).to_lowercase();
@@ -322,6 +370,10 @@ impl Checker<'_> {
         if o.kind != ObjectType::Sdf {
             self.check_fields(span.clone(), &label, &kind, &fields, takes, &[])?;
         }
+        if o.kind == ObjectType::Mesh && o.material.is_none() && o.emission.is_none() {
+            let transform = self.transform(span.clone(), &label, o)?;
+            return self.mesh_with_materials(span, &label, o.file.as_ref().unwrap(), transform);
+        }
         let get = |p: Option<Point>, name: &str| self.finite3(span.clone(), &format!("{label}.{name}"), p.unwrap().0);
         let shape = match o.kind {
             ObjectType::Sphere => {
@@ -352,6 +404,18 @@ impl Checker<'_> {
             ObjectType::Sdf => Shape::Sdf(self.sdf_object(span.clone(), &label, o)?),
         };
         let transform = self.transform(span.clone(), &label, o)?;
+        if let Some(emission) = o.emission {
+            let radiance = self.non_negative3(span.clone(), &format!("{label}.emission"), emission.0)?;
+            if let Some(material) = &o.material {
+                return Err(self.err(
+                    material.span(),
+                    format!("{label}: an emitting object's surface is black and reflects nothing; drop its `material`"),
+                ));
+            }
+            let placed = self.placed(span.clone(), &label, shape.transformed(transform))?;
+            let lights = self.emitter(span, &label, placed, radiance)?;
+            return Ok(Built { lights, ..Built::default() });
+        }
         let material = match &o.material {
             Some(name) => {
                 if !scene.materials.contains_key(name.get_ref()) {
@@ -367,7 +431,121 @@ impl Checker<'_> {
                 return Err(self.err(span, format!("{label} needs a `material` (a name from [materials])")));
             }
         };
-        Ok((self.placed(span, &label, shape.transformed(transform))?, material))
+        let objects = vec![(self.placed(span, &label, shape.transformed(transform))?, material)];
+        Ok(Built { objects, ..Built::default() })
+    }
+
+    /// One `[[include]]`: a glTF file, or an OBJ file as a mesh object
+    /// would take it.
+    fn include(&self, index: usize, desc: &Spanned<IncludeDesc>, scene: &SceneDesc) -> Result<gltf::Imported> {
+        let span = desc.span();
+        let d = desc.get_ref();
+        let label = format!("include[{index}]");
+        let transform = self.transform_parts(span.clone(), &label, d.translate, d.rotate, d.scale)?;
+        if let Some(name) = &d.material
+            && !scene.materials.contains_key(name.get_ref())
+        {
+            let known: Vec<&str> = scene.materials.keys().map(String::as_str).collect();
+            return Err(self.err(
+                name.span(),
+                format!("{label}: unknown material `{}`; the scene defines: {}", name.get_ref(), list(&known)),
+            ));
+        }
+        let material = d.material.as_ref().map(|m| m.get_ref().as_str());
+        let file = d.file.get_ref().to_ascii_lowercase();
+        if file.ends_with(".obj") {
+            if d.scene.is_some() {
+                return Err(self.err_field(span, "scene", format!("{label}: `scene` is for glTF files")));
+            }
+            let built = match material {
+                Some(name) => {
+                    let shape = self.placed(span, &label, self.mesh(&label, &d.file)?.transformed(transform))?;
+                    Built { objects: vec![(shape, name.to_string())], ..Built::default() }
+                }
+                None => self.mesh_with_materials(span, &label, &d.file, transform)?,
+            };
+            return Ok(gltf::Imported { built, camera: None, textures_skipped: 0 });
+        }
+        if !(file.ends_with(".gltf") || file.ends_with(".glb")) {
+            return Err(self.err(d.file.span(), format!("{label}: `file` must be a .gltf, .glb or .obj file")));
+        }
+        let imported =
+            self.gltf(&gltf::Include { label: &label, file: &d.file, scene: d.scene.as_deref(), transform, material })?;
+        if imported.textures_skipped > 0 {
+            self.notes.borrow_mut().push(format!(
+                "{label}: {} primitives have a base-colour texture, which Airlight does not read yet; \
+                 they take their base colour factor",
+                imported.textures_skipped
+            ));
+        }
+        Ok(imported)
+    }
+
+    /// A mesh object without a `material`: its faces take the `.mtl`
+    /// materials their `usemtl` names, `Kd` as a diffuse albedo (0.8 when
+    /// absent), and faces whose material has a `Ke` emit it.
+    fn mesh_with_materials(
+        &self,
+        span: Range<usize>,
+        label: &str,
+        file: &Spanned<String>,
+        transform: Affine3A,
+    ) -> Result<Built> {
+        let parts = self.mesh_parts(label, file)?;
+        let only_part = parts.len() == 1;
+        let mut built = Built::default();
+        for part in parts {
+            let Some(m) = part.material else {
+                let why = if only_part {
+                    "(a name from [materials]), or faces with `usemtl` materials from an `mtllib`"
+                } else {
+                    "for its faces before the first `usemtl`"
+                };
+                return Err(self.err(span, format!("{label} needs a `material` {why}")));
+            };
+            let placed = self.placed(span.clone(), label, part.shape.transformed(transform))?;
+            match m.emission {
+                Some(radiance) if radiance.max_element() > 0.0 => {
+                    built.lights.extend(self.emitter(span.clone(), label, placed, radiance)?)
+                }
+                _ => {
+                    let name = format!("{}:{}", file.get_ref(), m.name);
+                    built.materials.push((name.clone(), Material::diffuse(m.diffuse.unwrap_or(Vec3::splat(0.8)))));
+                    built.objects.push((placed, name));
+                }
+            }
+        }
+        Ok(built)
+    }
+
+    /// The lights an emitting object becomes: a sphere light, a quad light,
+    /// or a triangle light per triangle of a mesh (degenerate triangles,
+    /// which emit nothing, are left out).
+    fn emitter(&self, span: Range<usize>, label: &str, shape: Shape, radiance: Rgb) -> Result<Vec<Light>> {
+        match shape {
+            Shape::Sphere { center, radius } => Ok(vec![Light::sphere(center, radius, radiance)]),
+            Shape::Quad { corner, edge_u, edge_v } => Ok(vec![Light::quad(corner, edge_u, edge_v, radiance)]),
+            Shape::Mesh { positions, triangles } => {
+                let mut lights = Vec::new();
+                lights.try_reserve_exact(triangles.len()).map_err(|_| {
+                    self.err(span.clone(), format!("{label}: no memory for {} triangle lights", triangles.len()))
+                })?;
+                for [a, b, c] in triangles.iter().map(|t| t.map(|i| positions[i as usize])) {
+                    if (b - a).cross(c - a).length_squared().is_normal() {
+                        lights.push(Light::triangle(a, b, c, radiance));
+                    }
+                }
+                Ok(lights)
+            }
+            _ => Err(self.err_field(
+                span,
+                "emission",
+                format!(
+                    "{label}: only sphere, quad and mesh objects can emit (a sphere stretched by `scale` \
+                     cannot either)"
+                ),
+            )),
+        }
     }
 
     /// A shape in world space, checked for what its transform may have

@@ -24,6 +24,22 @@ pub struct SceneDesc {
     pub objects: Vec<Spanned<ObjectDesc>>,
     #[serde(default)]
     pub lights: Vec<Spanned<LightDesc>>,
+    #[serde(default)]
+    pub include: Vec<Spanned<IncludeDesc>>,
+}
+
+/// One `[[include]]` table: a glTF or OBJ file placed in the scene.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct IncludeDesc {
+    pub file: Spanned<String>,
+    /// glTF: the scene to take, by name (default: the file's default scene).
+    pub scene: Option<String>,
+    /// A material from `[materials]` for every surface, instead of the file's.
+    pub material: Option<Spanned<String>>,
+    pub translate: Option<Point>,
+    pub rotate: Option<Point>,
+    pub scale: Option<Triple>,
 }
 
 /// The `[render]` table: film and sampling settings, which the scene keeps
@@ -169,6 +185,9 @@ pub struct ObjectDesc {
     pub min: Option<Point>,
     pub max: Option<Point>,
     pub file: Option<Spanned<String>>,
+    /// Radiance the surface emits (sphere, quad and mesh objects): the
+    /// object becomes area lights, one per triangle for a mesh.
+    pub emission: Option<Triple>,
     pub translate: Option<Point>,
     pub rotate: Option<Point>,
     pub scale: Option<Triple>,

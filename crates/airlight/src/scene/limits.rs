@@ -55,6 +55,7 @@ pub fn light_extent(light: &Light) -> f32 {
         Light::Quad { corner, edge_u, edge_v, .. } => {
             reach([corner, corner + edge_u, corner + edge_v, corner + edge_u + edge_v, edge_u, edge_v])
         }
+        Light::Triangle { a, edge_1, edge_2, .. } => reach([a, a + edge_1, a + edge_2, edge_1, edge_2]),
         Light::Line { start, end, .. } => reach([start, end]),
         Light::Volume { shape, .. } => {
             let (lo, hi) = shape.bounds();

@@ -14,9 +14,11 @@ mod build_camera;
 mod build_lights;
 pub mod desc;
 mod error;
+mod gltf;
 mod lights;
 pub mod limits;
 mod mesh;
+mod mtl;
 pub mod obj;
 mod sdf;
 mod warnings;
@@ -152,6 +154,8 @@ pub struct Scene {
     light_culling: LightCulling,
     /// The files the scene was read from (see [`Scene::files`]).
     pub(crate) files: Vec<std::path::PathBuf>,
+    /// What the scene file asked for that Airlight does not do (yet).
+    pub(crate) notes: Vec<String>,
 }
 
 impl Scene {
@@ -160,6 +164,12 @@ impl Scene {
     /// in code). Outputs must not replace them.
     pub fn files(&self) -> &[std::path::PathBuf] {
         &self.files
+    }
+
+    /// What the scene file asked for that Airlight does not do yet (a
+    /// glTF texture, for one), for the user to be told.
+    pub fn notes(&self) -> &[String] {
+        &self.notes
     }
 
     pub fn settings(&self) -> &RenderSettings {
@@ -525,6 +535,7 @@ impl SceneBuilder {
             bounds_radius: 1.0,
             light_culling,
             files: Vec::new(),
+            notes: Vec::new(),
         };
         scene.geometry = build_geometry(scene.surfaces());
         scene.update_bounds();
@@ -557,6 +568,11 @@ fn bounding_sphere(geometry: &Geometry, lights: &[Light], camera: &Camera) -> (V
             }
             Light::Quad { corner, edge_u, edge_v, .. } => {
                 for p in [corner, corner + edge_u, corner + edge_v, corner + edge_u + edge_v] {
+                    grow(p);
+                }
+            }
+            Light::Triangle { a, edge_1, edge_2, .. } => {
+                for p in [a, a + edge_1, a + edge_2] {
                     grow(p);
                 }
             }

@@ -1,8 +1,9 @@
 //! Wavefront OBJ meshes: the vertex positions (`v`) and faces (`f`) a
 //! mesh object needs, polygons cut into fans of triangles (the first vertex
-//! with each following pair). Everything else (texture coordinates,
-//! normals, groups, `mtllib` and `usemtl`: materials come from the scene)
-//! is skipped unread, so an OBJ never makes Airlight open another file.
+//! with each following pair), and the names of the material libraries
+//! (`mtllib`) and materials (`usemtl`) the faces use; the libraries are
+//! opened by the caller, only when the scene asks for them (mtl.rs).
+//! Everything else (texture coordinates, normals, groups) is skipped.
 //!
 //! Indices count from 1, or back from the latest vertex when negative, and
 //! may refer to vertices defined later in the file. Errors name the line.
@@ -20,6 +21,12 @@ pub const BYTES_PER_TRIANGLE: u64 = 96;
 pub struct Obj {
     pub positions: Vec<Vec3>,
     pub triangles: Vec<[u32; 3]>,
+    /// `mtllib` file names, with the line that names them.
+    pub libraries: Vec<(String, usize)>,
+    /// Runs of triangles that share a `usemtl`: the first triangle of each
+    /// run and the material's name with its line (None before any
+    /// `usemtl`); a run lasts until the next one starts.
+    pub material_runs: Vec<(usize, Option<(String, usize)>)>,
 }
 
 /// What is wrong, and on which line (1-based; 0 for the file as a whole).
@@ -107,8 +114,25 @@ pub fn parse(bytes: &[u8], vertices: u64, triangles: u64) -> Result<Obj, ObjErro
                 if face.len() < 3 {
                     return fail(n, format!("a face needs at least 3 vertices, got {}", face.len()));
                 }
+                if obj.material_runs.is_empty() {
+                    obj.material_runs.push((0, None));
+                }
                 for pair in face[1..].windows(2) {
                     obj.triangles.push([face[0], pair[0], pair[1]]);
+                }
+            }
+            b"usemtl" => {
+                let name = words.map(|w| String::from_utf8_lossy(w)).collect::<Vec<_>>().join(" ");
+                let run = (obj.triangles.len(), Some((name, n)));
+                match obj.material_runs.last_mut() {
+                    // A run without faces gives way to the next.
+                    Some(last) if last.0 == obj.triangles.len() => *last = run,
+                    _ => obj.material_runs.push(run),
+                }
+            }
+            b"mtllib" => {
+                for word in words {
+                    obj.libraries.push((String::from_utf8_lossy(word).into_owned(), n));
                 }
             }
             _ => {}
@@ -165,9 +189,22 @@ mod tests {
                 .unwrap();
         assert_eq!(obj.positions.len(), 4);
         assert_eq!(obj.triangles, vec![[0, 1, 2], [0, 2, 3]]);
+        assert_eq!(obj.libraries, vec![("evil.mtl".to_string(), 2)]);
+        assert_eq!(obj.material_runs, vec![(0, None)]);
         assert_eq!(count(b"v 0 0 0\r\nf 1 1 1 1 1\n"), (1, 3));
         // A forward reference is allowed; \r\n line ends too.
         assert_eq!(read("f 1 2 3\r\nv 0 0 0\r\nv 1 0 0\r\nv 0 1 0\r\n").unwrap().triangles, vec![[0, 1, 2]]);
+    }
+
+    #[test]
+    fn faces_keep_the_material_they_were_given() {
+        let obj =
+            read("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nusemtl a\nusemtl warm light\nf 1 2 3 3\nusemtl a\nf 3 2 1\n")
+                .unwrap();
+        let runs: Vec<(usize, Option<&str>)> =
+            obj.material_runs.iter().map(|(start, m)| (*start, m.as_ref().map(|(n, _)| n.as_str()))).collect();
+        assert_eq!(runs, vec![(0, None), (1, Some("warm light")), (3, Some("a"))]);
+        assert_eq!(obj.material_runs[1].1.as_ref().unwrap().1, 6, "the line of its usemtl");
     }
 
     #[test]

@@ -42,7 +42,7 @@ fn emits(light: &Light) -> bool {
         | Light::Spot { intensity, .. }
         | Light::Line { intensity, .. }
         | Light::Volume { intensity, .. } => intensity,
-        Light::Sphere { radiance, .. } | Light::Quad { radiance, .. } => radiance,
+        Light::Sphere { radiance, .. } | Light::Quad { radiance, .. } | Light::Triangle { radiance, .. } => radiance,
         Light::Distant { irradiance, .. } => irradiance,
     };
     power.max_element() > 0.0

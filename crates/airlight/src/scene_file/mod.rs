@@ -27,9 +27,16 @@ impl SceneFile {
     /// [`SceneFile::load`], with meshes also looked for in `asset_dirs`,
     /// after the scene's folder ([`AssetPath::from_env`] reads them from
     /// `AIRLIGHT_ASSET_PATH`).
+    /// A `.gltf` or `.glb` file is read as the scene of one `[[include]]`
+    /// of it, with every other setting at its default.
     pub fn load_with(path: &Path, asset_dirs: &[PathBuf]) -> Result<SceneFile, SceneError> {
-        let text = read_text(path, MAX_SCENE_BYTES, "scene file").map_err(|e| e.in_file(path))?;
         let assets = AssetPath::new(path.parent(), asset_dirs);
+        if let Some(gltf) = path.file_name().filter(|_| is_gltf(path)) {
+            let text = format!("[[include]]\nfile = {}\n", toml::Value::from(gltf.to_string_lossy().into_owned()));
+            // The error is the glTF file's, not of the text made here.
+            return Self::from_toml_with(&text, &assets).map_err(|e| SceneError { location: None, ..e }.in_file(path));
+        }
+        let text = read_text(path, MAX_SCENE_BYTES, "scene file").map_err(|e| e.in_file(path))?;
         let mut file = Self::from_toml_with(&text, &assets).map_err(|e| e.in_file(path))?;
         let mut files = vec![path.canonicalize().unwrap_or_else(|_| path.to_path_buf())];
         files.append(&mut file.scene.files);
@@ -51,6 +58,11 @@ impl SceneFile {
         let scene = scene::build(&desc, text, assets)?;
         Ok(SceneFile { scene, integrator })
     }
+}
+
+/// Whether `path` names a glTF file (`.gltf` or `.glb`, any case).
+pub fn is_gltf(path: &Path) -> bool {
+    path.extension().is_some_and(|e| e.eq_ignore_ascii_case("gltf") || e.eq_ignore_ascii_case("glb"))
 }
 
 /// A fingerprint of a scene as resolved for a render (its file's values and

@@ -1,9 +1,10 @@
-//! Line, quad and sphere lights as sums of point emitters, chosen per ray.
+//! Line, quad, triangle and sphere lights as sums of point emitters, chosen
+//! per ray.
 
 use super::{Analytic, Emission, PointEmitter, quadrature};
 use glam::DVec3;
 
-/// A line or quad light: its points are chosen per ray.
+/// A line, quad or triangle light: its points are chosen per ray.
 #[derive(Clone, Copy, Debug)]
 pub(super) enum Extended {
     Line {
@@ -22,19 +23,31 @@ pub(super) enum Extended {
         intensity: DVec3,
         light: u32,
     },
+    Triangle {
+        a: DVec3,
+        edge_1: DVec3,
+        edge_2: DVec3,
+        normal: DVec3,
+        /// radiance × area: the intensity along the normal, W/sr.
+        intensity: DVec3,
+        light: u32,
+    },
 }
 
 impl Extended {
     pub(super) fn intensity(&self) -> DVec3 {
         match *self {
-            Extended::Line { intensity, .. } | Extended::Quad { intensity, .. } => intensity,
+            Extended::Line { intensity, .. }
+            | Extended::Quad { intensity, .. }
+            | Extended::Triangle { intensity, .. } => intensity,
         }
     }
 }
 
 /// How many times a line light's piece may be halved for one ray.
 const MAX_LINE_SPLITS: u32 = 8;
-/// How many times a quad light's piece may be quartered for one ray.
+/// How many times a quad or triangle light's piece may be quartered for
+/// one ray.
 const MAX_QUAD_SPLITS: u32 = 5;
 
 impl Analytic {
@@ -118,6 +131,52 @@ impl Analytic {
                 each(&PointEmitter {
                     position: c + u * *x + v * *y,
                     intensity: intensity * (wx * wy),
+                    emission: Emission::Cosine { normal },
+                    light,
+                    gap: 0.0,
+                });
+            }
+        }
+    }
+}
+
+impl Analytic {
+    /// The points of a piece of a triangle light (vertex `a`, edges), split
+    /// in four at its edges' midpoints where the ray passes close. The rule
+    /// is the square's, carried onto the triangle by Duffy's map
+    /// (x, y) ↦ a + x(1 − y)·e₁ + x·y·e₂, whose Jacobian 2x (as a share of
+    /// the area) multiplies the weights: exact for the constant, and as
+    /// accurate as the square's rule for smooth kernels.
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn triangle_pieces(
+        &self,
+        o: DVec3,
+        d: DVec3,
+        t_end: f64,
+        (a, e1, e2): (DVec3, DVec3, DVec3),
+        normal: DVec3,
+        intensity: DVec3,
+        light: u32,
+        depth: u32,
+        each: &mut dyn FnMut(&PointEmitter),
+    ) {
+        let centre = a + (e1 + e2) / 3.0;
+        let half = [a, a + e1, a + e2].iter().map(|v| (*v - centre).length()).fold(0.0, f64::max);
+        if self.must_split(o, d, t_end, centre, half, depth, MAX_QUAD_SPLITS) {
+            let (h1, h2) = (0.5 * e1, 0.5 * e2);
+            // Three corner triangles and the middle one, turned about but
+            // with the same normal ((−h₁) × (−h₂) = h₁ × h₂).
+            for piece in [(a, h1, h2), (a + h1, h1, h2), (a + h2, h1, h2), (a + h1 + h2, -h1, -h2)] {
+                self.triangle_pieces(o, d, t_end, piece, normal, intensity * 0.25, light, depth + 1, each);
+            }
+            return;
+        }
+        let rule = &self.rule;
+        for (x, wx) in rule.nodes.iter().zip(&rule.weights) {
+            for (y, wy) in rule.nodes.iter().zip(&rule.weights) {
+                each(&PointEmitter {
+                    position: a + e1 * (x * (1.0 - y)) + e2 * (x * y),
+                    intensity: intensity * (2.0 * x * wx * wy),
                     emission: Emission::Cosine { normal },
                     light,
                     gap: 0.0,

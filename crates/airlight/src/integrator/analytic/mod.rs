@@ -287,6 +287,18 @@ impl Analytic {
                         light: index,
                     });
                 }
+                Light::Triangle { a, edge_1, edge_2, radiance } => {
+                    let (e1, e2) = (edge_1.as_dvec3(), edge_2.as_dvec3());
+                    let n = e1.cross(e2);
+                    extended.push(Extended::Triangle {
+                        a: a.as_dvec3(),
+                        edge_1: e1,
+                        edge_2: e2,
+                        normal: n.normalize(),
+                        intensity: radiance.as_dvec3() * (0.5 * n.length()),
+                        light: index,
+                    });
+                }
                 Light::Volume { .. } => {
                     return Err(format!(
                         "the analytic integrator has no closed form for a volume light (lights[{i}]): use stochastic"
@@ -342,6 +354,9 @@ impl Analytic {
                     }
                     Extended::Quad { corner, edge_u, edge_v, normal, intensity, light } => {
                         self.quad_pieces(o, d, t_end, (corner, edge_u, edge_v), normal, intensity, light, 0, &mut each)
+                    }
+                    Extended::Triangle { a, edge_1, edge_2, normal, intensity, light } => {
+                        self.triangle_pieces(o, d, t_end, (a, edge_1, edge_2), normal, intensity, light, 0, &mut each)
                     }
                 }
             }

@@ -1,0 +1,117 @@
+//! `airlight render --aov`: albedo, normals, depth and variance as layers
+//! of the EXR output, with the channel names compositors read, checked by
+//! reading the file back with the `exr` crate.
+
+use std::collections::HashMap;
+use std::path::Path;
+use std::process::{Command, Output};
+
+fn airlight(dir: &Path, args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_airlight")).current_dir(dir).args(args).output().unwrap()
+}
+
+/// A grey floor at y = 0 seen from straight above at height 3, with a
+/// sphere of another colour on it, under a point light.
+const SCENE: &str = r#"
+[render]
+width = 16
+height = 16
+spp = 8
+integrator = "path"
+[camera]
+position = [0, 3, 0]
+look_at = [0, 0, 0]
+up = [0, 0, 1]
+fov = 40
+[materials.grey]
+albedo = [0.5, 0.5, 0.5]
+[materials.blue]
+albedo = [0.1, 0.2, 0.7]
+[[objects]]
+type = "plane"
+point = [0, 0, 0]
+normal = [0, 1, 0]
+material = "grey"
+[[objects]]
+type = "sphere"
+center = [0, 0.5, 0]
+radius = 0.5
+material = "blue"
+[[lights]]
+type = "point"
+position = [1, 2, 1]
+intensity = 5
+"#;
+
+/// Every channel of the file's first layer, by name.
+fn channels(path: &Path) -> HashMap<String, Vec<f32>> {
+    use exr::prelude::*;
+    let image = read().no_deep_data().largest_resolution_level().all_channels().first_valid_layer().all_attributes();
+    let image = image.from_file(path).unwrap();
+    let mut out = HashMap::new();
+    for c in &image.layer_data.channel_data.list {
+        out.insert(c.name.to_string(), c.sample_data.values_as_f32().collect());
+    }
+    out
+}
+
+#[test]
+fn aovs_are_layers_of_the_exr_with_standard_names() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("s.toml"), SCENE).unwrap();
+    let run = airlight(
+        dir.path(),
+        &["render", "s.toml", "--aov", "albedo,normal,depth,variance", "-o", "out.exr", "-o", "out.png", "-q"],
+    );
+    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+    let plain = airlight(dir.path(), &["render", "s.toml", "--progressive", "-o", "plain.exr", "-q"]);
+    assert!(plain.status.success());
+    let with = channels(&dir.path().join("out.exr"));
+    let mut names: Vec<&str> = with.keys().map(String::as_str).collect();
+    names.sort();
+    assert_eq!(
+        names,
+        [
+            "B",
+            "G",
+            "N.X",
+            "N.Y",
+            "N.Z",
+            "R",
+            "Z",
+            "albedo.B",
+            "albedo.G",
+            "albedo.R",
+            "variance.B",
+            "variance.G",
+            "variance.R"
+        ]
+    );
+    // The image is the render's, AOVs or not.
+    let without = channels(&dir.path().join("plain.exr"));
+    for c in ["R", "G", "B"] {
+        assert_eq!(with[c], without[c], "channel {c}");
+    }
+    // The centre pixel sees the top of the sphere: its albedo, the normal
+    // straight up, 2 away (its top is at y = 1). A corner sees the floor,
+    // 3/cos θ away.
+    let at = |name: &str, x: usize, y: usize| with[name][y * 16 + x];
+    let (cx, cy) = (8, 8);
+    assert!((at("albedo.B", cx, cy) - 0.7).abs() < 1e-5 && (at("albedo.R", cx, cy) - 0.1).abs() < 1e-5);
+    assert!(at("N.Y", cx, cy) > 0.99, "{}", at("N.Y", cx, cy));
+    assert!((at("Z", cx, cy) - 2.0).abs() < 0.02, "{}", at("Z", cx, cy));
+    assert!((at("albedo.G", 0, 0) - 0.5).abs() < 1e-5);
+    assert!(at("Z", 0, 0) > 3.0 && at("Z", 0, 0) < 3.0 / 20f32.to_radians().cos().powi(2));
+    // Variance: finite, not negative, and not zero where the light is noisy.
+    assert!(with["variance.R"].iter().all(|v| v.is_finite() && *v >= 0.0));
+    assert!(with["variance.R"].iter().any(|v| *v > 0.0));
+
+    // Refusals: no EXR output, an unknown name, a shard.
+    let no_exr = airlight(dir.path(), &["render", "s.toml", "--aov", "albedo", "-o", "a.png", "-q"]);
+    assert!(String::from_utf8_lossy(&no_exr.stderr).contains("give an output ending in .exr"));
+    let unknown = airlight(dir.path(), &["render", "s.toml", "--aov", "albedo,colour", "-o", "a.exr", "-q"]);
+    assert!(String::from_utf8_lossy(&unknown.stderr).contains("unknown AOV `colour`"));
+    let shard = airlight(dir.path(), &["render", "s.toml", "--aov", "depth", "--shard", "0/2", "-o", "p.exr", "-q"]);
+    assert!(String::from_utf8_lossy(&shard.stderr).contains("a shard or tile is a partial EXR"));
+    assert!(!dir.path().join("a.exr").exists() && !dir.path().join("p.exr").exists());
+}

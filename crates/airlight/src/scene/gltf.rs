@@ -1,0 +1,314 @@
+//! glTF 2.0 scenes (`.gltf` with its buffers, or `.glb`), read with the
+//! `gltf` crate: the node hierarchy with its transforms, triangle meshes,
+//! `KHR_lights_punctual` lights, materials' base colour and emission
+//! (`KHR_materials_emissive_strength`), and the first camera. What Airlight
+//! makes of each is in docs/scene-format.md ("glTF scenes").
+//!
+//! Buffers in files are found beside the glTF file under the asset rules
+//! ([`super::assets`]); data URIs are decoded. Every accessor read is
+//! checked against its buffer first, so a short or lying file gives an
+//! error, never a panic. Errors name the file, the JSON path
+//! (`meshes[2].primitives[0]`) and what is wrong.
+
+use super::assets::{MAX_MESH_BYTES, read_limited};
+use super::build::{Built, Checker, Result};
+use crate::camera::Camera;
+use crate::geometry::Shape;
+use crate::light::{Attenuation, Light, SpotProfile};
+use crate::material::Material;
+use base64::Engine;
+use glam::{Affine3A, Mat4, Vec3};
+use std::path::Path;
+use toml::Spanned;
+
+/// Luminous efficacy used to turn glTF's photometric light units into
+/// radiometric ones: 683 lm/W, that of light at 555 nm (the definition of
+/// the candela). A point light of I cd has I/683 W/sr; a sun of E lux
+/// gives E/683 W/m². Blender's exporter writes a P-watt point light as
+/// P/(4π)·683 cd, so it comes back as Blender's P/(4π) W/sr.
+pub const LUMINOUS_EFFICACY: f32 = 683.0;
+
+/// Deepest node hierarchy followed (a cycle would otherwise never end).
+const MAX_DEPTH: usize = 256;
+
+/// What a glTF file adds to a scene.
+pub(super) struct Imported {
+    pub built: Built,
+    /// The first camera met, with its aspect ratio when the file gives one.
+    pub camera: Option<(Camera, Option<f32>)>,
+    /// Base-colour textures the file has that were not read.
+    pub textures_skipped: usize,
+}
+
+/// What is being imported and how: the include's label, file, scene name,
+/// transform and material override.
+pub(super) struct Include<'a> {
+    pub label: &'a str,
+    pub file: &'a Spanned<String>,
+    pub scene: Option<&'a str>,
+    pub transform: Affine3A,
+    pub material: Option<&'a str>,
+}
+
+impl Checker<'_> {
+    pub(super) fn gltf(&self, include: &Include) -> Result<Imported> {
+        let name = include.file.get_ref();
+        let fail = |why: String| self.err(include.file.span(), format!("{}: `{name}`: {why}", include.label));
+        let path = self.assets.resolve(name).map_err(|why| fail(format!("cannot load: {why}")))?;
+        let bytes = read_limited(&path, MAX_MESH_BYTES).map_err(|why| fail(format!("cannot load: {why}")))?;
+        // The crate validates the document, and refuses one that requires
+        // an extension other than those Airlight reads (Cargo.toml).
+        let gltf = gltf::Gltf::from_slice(&bytes).map_err(|e| fail(format!("not a valid glTF file: {e}")))?;
+        self.files.borrow_mut().push(path);
+        let buffers = self.gltf_buffers(&gltf, Path::new(name)).map_err(fail)?;
+        let scene = match include.scene {
+            Some(wanted) => gltf.scenes().find(|s| s.name() == Some(wanted)).ok_or_else(|| {
+                let names: Vec<String> = gltf.scenes().filter_map(|s| s.name().map(|n| format!("`{n}`"))).collect();
+                fail(format!(
+                    "no scene named `{wanted}` (it has {})",
+                    if names.is_empty() { "none named".into() } else { names.join(", ") }
+                ))
+            })?,
+            None => {
+                gltf.default_scene().or_else(|| gltf.scenes().next()).ok_or_else(|| fail("it holds no scene".into()))?
+            }
+        };
+        // Memory: every primitive's triangles, counted before any is read.
+        let triangles: u64 = gltf
+            .meshes()
+            .flat_map(|m| m.primitives())
+            .map(|p| p.indices().or_else(|| p.get(&gltf::Semantic::Positions)).map_or(0, |a| a.count() as u64 / 3))
+            .sum();
+        let needed = self.mesh_bytes.get() + triangles.saturating_mul(super::obj::BYTES_PER_TRIANGLE + 36);
+        crate::memory::check(format!("the scene's meshes ({triangles} triangles in this glTF)"), needed)
+            .map_err(|e| fail(e.to_string()))?;
+        self.mesh_bytes.set(needed);
+
+        let mut out = Imported { built: Built::default(), camera: None, textures_skipped: 0 };
+        let mut stack: Vec<(gltf::Node, Affine3A, usize)> =
+            scene.nodes().map(|n| (n, include.transform, 0)).collect::<Vec<_>>();
+        stack.reverse();
+        while let Some((node, parent, depth)) = stack.pop() {
+            let at = format!("nodes[{}]", node.index());
+            if depth > MAX_DEPTH {
+                return Err(fail(format!("{at}: the node hierarchy is deeper than {MAX_DEPTH} (a cycle?)")));
+            }
+            let local = Mat4::from_cols_array_2d(&node.transform().matrix());
+            if !local.is_finite() || local.row(3) != glam::Vec4::W {
+                return Err(fail(format!("{at}: its transform is not a finite affine matrix: {local}")));
+            }
+            let world = parent * Affine3A::from_mat4(local);
+            if let Some(mesh) = node.mesh() {
+                self.gltf_mesh(include, &mesh, world, &buffers, &mut out).map_err(&fail)?;
+            }
+            if let Some(light) = node.light() {
+                out.built.lights.push(gltf_light(&light, world).map_err(|why| fail(format!("{at}: {why}")))?);
+            }
+            if let (Some(camera), None) = (node.camera(), &out.camera) {
+                out.camera = Some(gltf_camera(&camera, world).map_err(|why| fail(format!("{at}: {why}")))?);
+            }
+            for child in node.children().collect::<Vec<_>>().into_iter().rev() {
+                stack.push((child, world, depth + 1));
+            }
+        }
+        Ok(out)
+    }
+
+    /// Each buffer's bytes: the GLB's BIN chunk, a data URI, or a file
+    /// beside the glTF file.
+    fn gltf_buffers(&self, gltf: &gltf::Gltf, file: &Path) -> std::result::Result<Vec<Vec<u8>>, String> {
+        let mut buffers = Vec::new();
+        for buffer in gltf.buffers() {
+            let at = format!("buffers[{}]", buffer.index());
+            let data = match buffer.source() {
+                gltf::buffer::Source::Bin => {
+                    gltf.blob.clone().ok_or_else(|| format!("{at}: refers to a BIN chunk the file does not have"))?
+                }
+                gltf::buffer::Source::Uri(uri) if uri.starts_with("data:") => {
+                    let (_, encoded) =
+                        uri.split_once(";base64,").ok_or_else(|| format!("{at}: a data URI that is not base64"))?;
+                    base64::engine::general_purpose::STANDARD
+                        .decode(encoded)
+                        .map_err(|e| format!("{at}: its data URI is not valid base64: {e}"))?
+                }
+                gltf::buffer::Source::Uri(uri) => {
+                    let beside = file.parent().unwrap_or(Path::new("")).join(uri);
+                    let path = self.assets.resolve(&beside.to_string_lossy()).map_err(|why| format!("{at}: {why}"))?;
+                    let data = read_limited(&path, MAX_MESH_BYTES).map_err(|why| format!("{at}: `{uri}`: {why}"))?;
+                    self.files.borrow_mut().push(path);
+                    data
+                }
+            };
+            if data.len() < buffer.length() {
+                return Err(format!("{at}: holds {} bytes, but the file says {}", data.len(), buffer.length()));
+            }
+            buffers.push(data);
+        }
+        Ok(buffers)
+    }
+
+    fn gltf_mesh(
+        &self,
+        include: &Include,
+        mesh: &gltf::Mesh,
+        world: Affine3A,
+        buffers: &[Vec<u8>],
+        out: &mut Imported,
+    ) -> std::result::Result<(), String> {
+        // A mirroring transform turns counter-clockwise front faces clockwise.
+        let mirrored = world.matrix3.determinant() < 0.0;
+        for primitive in mesh.primitives() {
+            let at = format!("meshes[{}].primitives[{}]", mesh.index(), primitive.index());
+            if primitive.mode() != gltf::mesh::Mode::Triangles {
+                return Err(format!("{at}: mode {:?} is not triangles", primitive.mode()));
+            }
+            let positions_accessor =
+                primitive.get(&gltf::Semantic::Positions).ok_or_else(|| format!("{at}: has no POSITION"))?;
+            fits(&positions_accessor, buffers).map_err(|why| format!("{at}: POSITION: {why}"))?;
+            if let Some(indices) = primitive.indices() {
+                fits(&indices, buffers).map_err(|why| format!("{at}: indices: {why}"))?;
+            }
+            let reader = primitive.reader(|b| buffers.get(b.index()).map(Vec::as_slice));
+            let positions: Vec<Vec3> = reader
+                .read_positions()
+                .ok_or_else(|| format!("{at}: POSITION cannot be read"))?
+                .map(|p| world.transform_point3(Vec3::from_array(p)))
+                .collect();
+            if let Some(p) = positions.iter().find(|p| !p.is_finite()) {
+                return Err(format!("{at}: a vertex is not finite once placed: {p}"));
+            }
+            let indices: Vec<u32> = match reader.read_indices() {
+                Some(indices) => indices.into_u32().collect(),
+                None => (0..positions.len() as u32).collect(),
+            };
+            if let Some(i) = indices.iter().find(|&&i| i as usize >= positions.len()) {
+                return Err(format!("{at}: index {i} is beyond its {} vertices", positions.len()));
+            }
+            let triangles: Vec<[u32; 3]> = indices
+                .chunks_exact(3)
+                .map(|t| if mirrored { [t[0], t[2], t[1]] } else { [t[0], t[1], t[2]] })
+                .collect();
+            if triangles.is_empty() {
+                continue;
+            }
+            let material = primitive.material();
+            if material.pbr_metallic_roughness().base_color_texture().is_some() {
+                out.textures_skipped += 1;
+            }
+            let strength = material.emissive_strength().unwrap_or(1.0);
+            let emission = Vec3::from_array(material.emissive_factor()) * strength;
+            if !(emission.is_finite() && emission.min_element() >= 0.0) {
+                return Err(format!("{at}: its material's emission is not finite and ≥ 0: {emission}"));
+            }
+            if emission.max_element() > 0.0 && include.material.is_none() {
+                for [a, b, c] in triangles.iter().map(|t| t.map(|i| positions[i as usize])) {
+                    if (b - a).cross(c - a).length_squared().is_normal() {
+                        out.built.lights.push(Light::triangle(a, b, c, emission));
+                    }
+                }
+                continue;
+            }
+            let name = match include.material {
+                Some(name) => name.to_string(),
+                None => {
+                    let [r, g, b, _] = material.pbr_metallic_roughness().base_color_factor();
+                    let name = match material.index() {
+                        Some(i) => format!("{}#materials[{i}]", include.file.get_ref()),
+                        None => format!("{}#default", include.file.get_ref()),
+                    };
+                    if !out.built.materials.iter().any(|(n, _)| *n == name) {
+                        let albedo = Vec3::new(r, g, b);
+                        if !(albedo.is_finite() && albedo.min_element() >= 0.0) {
+                            return Err(format!("{at}: its base colour is not finite and ≥ 0: {albedo}"));
+                        }
+                        out.built.materials.push((name.clone(), Material::diffuse(albedo)));
+                    }
+                    name
+                }
+            };
+            out.built.objects.push((Shape::Mesh { positions, triangles }, name));
+        }
+        Ok(())
+    }
+}
+
+/// Whether an accessor's bytes lie inside its buffer view and the view
+/// inside its buffer (the crate's reader assumes so).
+fn fits(accessor: &gltf::Accessor, buffers: &[Vec<u8>]) -> std::result::Result<(), String> {
+    if accessor.sparse().is_some() {
+        return Err("sparse accessors are not read".into());
+    }
+    let view = accessor.view().ok_or("an accessor without a bufferView")?;
+    let buffer = buffers.get(view.buffer().index()).map_or(0, Vec::len);
+    let view_end = view.offset().checked_add(view.length());
+    if view_end.is_none_or(|end| end > buffer) {
+        return Err(format!("bufferViews[{}] runs past the end of its buffer", view.index()));
+    }
+    let stride = view.stride().unwrap_or(accessor.size());
+    let end = match accessor.count() {
+        0 => Some(0),
+        n => (n - 1).checked_mul(stride).and_then(|s| s.checked_add(accessor.offset() + accessor.size())),
+    };
+    if end.is_none_or(|end| end > view.length()) {
+        return Err(format!("{} elements run past the end of bufferViews[{}]", accessor.count(), view.index()));
+    }
+    Ok(())
+}
+
+/// A `KHR_lights_punctual` light placed by its node: it shines along the
+/// node's −Z; colour × intensity, in candela (lux for a sun), over
+/// [`LUMINOUS_EFFICACY`]. A spot's outer cone is Airlight's `cone_angle`,
+/// its inner one `falloff_start`, with the smoothstep profile between.
+/// `range` is not used: lights fall off by the inverse-square law.
+fn gltf_light(light: &gltf::khr_lights_punctual::Light, world: Affine3A) -> std::result::Result<Light, String> {
+    let power = Vec3::from_array(light.color()) * (light.intensity() / LUMINOUS_EFFICACY);
+    if !(power.is_finite() && power.min_element() >= 0.0) {
+        return Err(format!("a light's colour × intensity is not finite and ≥ 0: {power}"));
+    }
+    let position = world.transform_point3(Vec3::ZERO);
+    let direction = world.transform_vector3(Vec3::NEG_Z).try_normalize().ok_or("a light's node has no direction")?;
+    use gltf::khr_lights_punctual::Kind;
+    Ok(match light.kind() {
+        Kind::Point => Light::point(position, power),
+        Kind::Directional => Light::distant(direction, power),
+        Kind::Spot { inner_cone_angle, outer_cone_angle } => {
+            if !(outer_cone_angle > 0.0 && inner_cone_angle >= 0.0 && inner_cone_angle <= outer_cone_angle) {
+                return Err(format!(
+                    "a spot's cone angles must satisfy 0 ≤ inner ≤ outer, outer > 0: {inner_cone_angle}, {outer_cone_angle}"
+                ));
+            }
+            Light::Spot {
+                position,
+                direction,
+                intensity: power,
+                cone_angle: outer_cone_angle,
+                falloff_start: inner_cone_angle,
+                profile: SpotProfile::Smoothstep,
+                attenuation: Attenuation::PHYSICAL,
+            }
+        }
+    })
+}
+
+/// A camera placed by its node: it looks along −Z with +Y up; `yfov` is
+/// Airlight's vertical `fov`, twice `ymag` its orthographic `view_height`.
+fn gltf_camera(camera: &gltf::Camera, world: Affine3A) -> std::result::Result<(Camera, Option<f32>), String> {
+    let position = world.transform_point3(Vec3::ZERO);
+    let forward = world.transform_vector3(Vec3::NEG_Z).try_normalize().ok_or("the camera's node has no direction")?;
+    let up = world.transform_vector3(Vec3::Y).try_normalize().ok_or("the camera's node has no up direction")?;
+    Ok(match camera.projection() {
+        gltf::camera::Projection::Perspective(p) => {
+            let fov = p.yfov().to_degrees();
+            if !(fov > 0.0 && fov < 180.0) {
+                return Err(format!("yfov must lie in (0, π), got {}", p.yfov()));
+            }
+            (Camera::look_at(position, position + forward, up, fov), p.aspect_ratio())
+        }
+        gltf::camera::Projection::Orthographic(o) => {
+            if !(o.ymag() > 0.0 && o.ymag().is_finite()) {
+                return Err(format!("ymag must be a positive number, got {}", o.ymag()));
+            }
+            (Camera::orthographic(position, position + forward, up, 2.0 * o.ymag()), Some(o.xmag() / o.ymag()))
+        }
+    })
+}
