@@ -28,11 +28,23 @@ class _Bar(Protocol):
 
 Progress = Union[Callable[[int, int], Any], _Bar, bool, None]
 
-class AOVs(TypedDict):
-    """``render(aovs=True)``'s arrays."""
+AOV = Literal["albedo", "normal", "depth", "variance"]
+
+class AOVs(TypedDict, total=False):
+    """``render(aovs=...)``'s arrays, float32, in the order asked for after ``color``; the
+    same values as the layers ``airlight render --aov`` writes."""
 
     color: _Image
-    """The image: each pixel the mean of its samples."""
+    """The image: each pixel the mean of its samples (always there)."""
+    albedo: _Image
+    """The diffuse albedo of the first surface the camera rays meet, averaged over the
+    render's camera rays (black for a light's own surface and where they meet nothing)."""
+    normal: _Image
+    """The first surface's unit normal in world space, turned toward the camera, averaged;
+    zero where the rays meet nothing."""
+    depth: npt.NDArray[np.float32]
+    """Shape (height, width): the distance along the camera ray to the first surface, the
+    mean over the samples that meet one; inf where none does."""
     variance: _Image
     """The estimated variance of each pixel's mean, per channel (inf with 1 sample)."""
 
@@ -129,7 +141,7 @@ class Scene:
         threads: int | None = None,
         shard: tuple[int, int] | None = None,
         progress: Progress = None,
-        aovs: Literal[False] = False,
+        aovs: Literal[False] | None = None,
         steps: int = ...,
         jitter: bool = ...,
         shadows: bool = ...,
@@ -154,7 +166,7 @@ class Scene:
         threads: int | None = None,
         shard: tuple[int, int] | None = None,
         progress: Progress = None,
-        aovs: Literal[True],
+        aovs: Literal[True] | str | Sequence[AOV],
         steps: int = ...,
         jitter: bool = ...,
         shadows: bool = ...,
@@ -176,8 +188,11 @@ class Scene:
         samples (:func:`shard_samples`) and returns their mean. ``progress`` is a callable
         ``f(done, total)`` (pixel samples), a tqdm bar, or True for a new tqdm bar; it is called
         on this thread at most every 0.1 s. The GIL is released while rendering; Ctrl-C stops
-        the render and raises KeyboardInterrupt. ``aovs=True`` returns a dict with ``color`` and
-        ``variance``.
+        the render and raises KeyboardInterrupt.
+
+        ``aovs`` (True for all, or names: a list, or a comma-separated string) returns a dict
+        of arrays instead, ``color`` first, then the AOVs asked for: ``albedo``, ``normal``,
+        ``depth`` and ``variance`` (see :class:`AOVs`); not with ``shard``.
 
         As ``airlight render`` does, an image too large for the memory left (or for
         ``AIRLIGHT_MEMORY_LIMIT``) raises ``MemoryError`` before anything is allocated, and a

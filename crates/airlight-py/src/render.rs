@@ -6,6 +6,7 @@
 use crate::errors::{integrator_error, internal_error, panic_message};
 use crate::scene::{Pose, Shared};
 use airlight::Rgb;
+use airlight::aov::{SurfaceAovs, surface_aovs};
 use airlight::film::PixelSum;
 use airlight::integrator::IntegratorDesc;
 use airlight::render::{RenderObserver, accumulate};
@@ -38,13 +39,17 @@ pub struct Job {
     pub threads: usize,
     /// Also the estimated variance of each pixel's mean.
     pub variance: bool,
+    /// Also the first hits' albedo, normal and depth.
+    pub surface: bool,
 }
 
 /// A render's pixels, H·W RGB triples each: the mean of each pixel's
-/// samples and, on request, its estimated variance.
+/// samples and, on request, its estimated variance and the first-hit
+/// outputs over the same camera rays.
 pub struct Output {
     pub color: Vec<f32>,
     pub variance: Option<Vec<f32>>,
+    pub surface: Option<SurfaceAovs>,
 }
 
 enum Failure {
@@ -155,7 +160,13 @@ fn work(job: &Job, state: &State) -> Result<Output, Failure> {
     }
     // Built here, off the GIL, into the buffer the array will own.
     let rgb = |f: &dyn Fn(&PixelSum) -> Rgb| acc.pixels().iter().flat_map(|p| f(p).to_array()).collect::<Vec<f32>>();
-    Ok(Output { color: rgb(&PixelSum::mean), variance: job.variance.then(|| rgb(&|p| p.variance_of_mean().as_vec3())) })
+    let color = rgb(&PixelSum::mean);
+    let variance = job.variance.then(|| rgb(&|p| p.variance_of_mean().as_vec3()));
+    // As `airlight render --aov` computes them: over the camera rays of the
+    // render's own samples.
+    let surface =
+        job.surface.then(|| pool.install(|| surface_aovs(&shared.scene, integrator.stratified(), job.samples.clone())));
+    Ok(Output { color, variance, surface })
 }
 
 /// The shared scene, once no other render holds it (scenes made by

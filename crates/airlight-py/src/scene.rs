@@ -12,11 +12,12 @@ use crate::errors::{Origin, guard, scene_error};
 use crate::options::{self, Film};
 use crate::render::{self, Job, Output, Progress};
 use airlight::SceneFile;
+use airlight::aov::Aov;
 use airlight::integrator::{Integrator, IntegratorDesc, IntegratorError, IntegratorKind};
 use airlight::light::Light;
 use airlight::scene::{AssetPath, RenderSettings, Scene};
-use numpy::PyArray3;
-use numpy::ndarray::Array3;
+use numpy::ndarray::{Array2, Array3};
+use numpy::{PyArray2, PyArray3};
 use pyo3::exceptions::{PyMemoryError, PyUserWarning, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -205,6 +206,32 @@ fn array(py: Python<'_>, pixels: Vec<f32>, w: u32, h: u32) -> PyResult<Bound<'_,
     Ok(PyArray3::from_owned_array(py, a))
 }
 
+/// An image's pixels as an (H, W, 3) array.
+fn image_array<'py>(py: Python<'py>, image: &airlight::Image) -> PyResult<Bound<'py, PyArray3<f32>>> {
+    array(py, image.pixels.iter().flat_map(|p| p.to_array()).collect(), image.width, image.height)
+}
+
+/// The outputs `aovs=` asks for: True for all, or names (a list, or one
+/// comma-separated string); the library's message for an unknown one.
+fn aov_list(arg: Option<&Bound<'_, PyAny>>) -> PyResult<Vec<Aov>> {
+    let Some(arg) = arg.filter(|a| !a.is_none()) else { return Ok(Vec::new()) };
+    if let Ok(flag) = arg.cast::<pyo3::types::PyBool>() {
+        return Ok(if flag.is_true() { Aov::ALL.to_vec() } else { Vec::new() });
+    }
+    let list = if let Ok(s) = arg.cast::<pyo3::types::PyString>() {
+        s.to_cow()?.into_owned()
+    } else {
+        let names: Vec<String> = arg.extract().map_err(|_| {
+            pyo3::exceptions::PyTypeError::new_err(
+                "aovs must be True, False, a list of names or a comma-separated string of them \
+                 (albedo, normal, depth, variance)",
+            )
+        })?;
+        names.join(",")
+    };
+    Aov::parse_list(&list).map_err(|e| PyValueError::new_err(format!("aovs: {e}")))
+}
+
 #[pymethods]
 impl PyScene {
     /// A scene from dicts with the scene file's keys (`render`, `camera`,
@@ -336,8 +363,12 @@ impl PyScene {
     /// - `progress`: a callable `f(done, total)` (pixel samples), a tqdm
     ///   bar, or True for a new tqdm bar; called on this thread at most
     ///   every 0.1 s. An exception it raises stops the render.
-    /// - `aovs=True`: a dict of named arrays instead, `color` and
-    ///   `variance` (the estimated variance of each pixel's mean).
+    /// - `aovs`: True for all, or names (a list, or a comma-separated
+    ///   string): a dict of float32 arrays instead, `color` first, then
+    ///   `albedo`, `normal` (H, W, 3) and `depth` (H, W) of the first hits
+    ///   over the render's camera rays, and `variance` (of each pixel's
+    ///   mean), as asked: the layers `airlight render --aov` writes. Not
+    ///   with `shard`.
     /// - Other keywords are integrator options by their scene-file names:
     ///   steps, jitter, shadows, light_steps, light_quadrature, sampling,
     ///   stratify, max_depth, bounces, patch_size, link_threshold; checked
@@ -349,7 +380,7 @@ impl PyScene {
     /// black gives a UserWarning, as the CLI warns.
     #[pyo3(signature = (
         integrator=None, *, spp=None, seed=None, width=None, height=None, threads=None,
-        shard=None, progress=None, aovs=false, **options
+        shard=None, progress=None, aovs=None, **options
     ))]
     #[allow(clippy::too_many_arguments)]
     fn render<'py>(
@@ -363,7 +394,7 @@ impl PyScene {
         threads: Option<i64>,
         shard: Option<(i64, i64)>,
         progress: Option<&Bound<'py, PyAny>>,
-        aovs: bool,
+        aovs: Option<&Bound<'py, PyAny>>,
         options: Option<&Bound<'py, PyDict>>,
     ) -> PyResult<Bound<'py, PyAny>> {
         guard(|| {
@@ -391,11 +422,20 @@ impl PyScene {
                 }
                 Some((k, n)) => airlight::film::partial::piece(spp, k as u64, n as u64),
             };
+            let aovs = aov_list(aovs)?;
+            if !aovs.is_empty() && shard.is_some() {
+                return Err(PyValueError::new_err(
+                    "aovs: a shard holds part of the samples; render the AOVs without shard, as \
+                     `airlight render --aov` refuses --shard",
+                ));
+            }
+            let variance = aovs.contains(&Aov::Variance);
+            let surface = aovs.iter().any(|a| *a != Aov::Variance);
             // As the CLI does before it renders: an image too large for
             // memory is refused, a scene that can only be black is warned of.
             let pixels = settings.width as u64 * settings.height as u64;
             let what = format!("a {}×{} render", settings.width, settings.height);
-            airlight::memory::check(what, airlight::memory::render_bytes(pixels, aovs))
+            airlight::memory::check(what, airlight::memory::render_bytes(pixels, variance))
                 .map_err(|e| PyMemoryError::new_err(format!("{e}: make the image smaller (width=, height=)")))?;
             let sees_medium = desc.kind != IntegratorKind::Direct;
             if let Some(why) = &self.summary.darkness[sees_medium as usize] {
@@ -408,16 +448,29 @@ impl PyScene {
             let (w, h) = (settings.width, settings.height);
             // A scene without keyframes is the same at every time.
             let pose = self.time.filter(|_| self.summary.animated);
-            let job = Job { shared: Arc::clone(&self.shared), settings, desc, pose, samples, threads, variance: aovs };
-            let Output { color, variance } = render::run(py, job, progress)?;
+            let shared = Arc::clone(&self.shared);
+            let job = Job { shared, settings, desc, pose, samples, threads, variance, surface };
+            let Output { color, mut variance, mut surface } = render::run(py, job, progress)?;
             let color = array(py, color, w, h)?;
-            if !aovs {
+            if aovs.is_empty() {
                 return Ok(color.into_any());
             }
             let out = PyDict::new(py);
             out.set_item("color", color)?;
-            if let Some(v) = variance {
-                out.set_item("variance", array(py, v, w, h)?)?;
+            for aov in aovs {
+                let missing = || crate::errors::internal_error(&format!("{} was not rendered", aov.name()));
+                let value = match aov {
+                    Aov::Variance => array(py, variance.take().ok_or_else(missing)?, w, h)?.into_any(),
+                    Aov::Albedo => image_array(py, &surface.as_ref().ok_or_else(missing)?.albedo)?.into_any(),
+                    Aov::Normal => image_array(py, &surface.as_ref().ok_or_else(missing)?.normal)?.into_any(),
+                    Aov::Depth => {
+                        let depth = std::mem::take(&mut surface.as_mut().ok_or_else(missing)?.depth);
+                        let depth = Array2::from_shape_vec((h as usize, w as usize), depth)
+                            .map_err(|e| crate::errors::internal_error(&format!("depth buffer: {e}")))?;
+                        PyArray2::from_owned_array(py, depth).into_any()
+                    }
+                };
+                out.set_item(aov.name(), value)?;
             }
             Ok(out.into_any())
         })

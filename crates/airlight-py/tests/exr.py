@@ -36,6 +36,12 @@ def _unzip(raw, size):
 
 def read_exr(path):
     """The R, G, B channels as a float32 array (height, width, 3)."""
+    planes = read_channels(path)
+    return np.stack([planes["R"], planes["G"], planes["B"]], axis=-1)
+
+
+def read_channels(path):
+    """Every channel, by name (``R``, ``albedo.R``, ``Z``...), as float32 arrays (height, width)."""
     with open(path, "rb") as f:
         data = f.read()
     assert data[:4] == b"\x76\x2f\x31\x01", "not an EXR file"
@@ -73,4 +79,4 @@ def read_exr(path):
                 step = w * np.dtype(t).itemsize
                 planes[name][y - y0 + row] = np.frombuffer(block[q : q + step], dtype=t)
                 q += step
-    return np.stack([planes["R"], planes["G"], planes["B"]], axis=-1)
+    return planes

@@ -54,12 +54,30 @@ def test_shards_are_means_that_combine_into_the_whole_render(fog):
     np.testing.assert_allclose(sum(parts) / 10, whole, rtol=1e-5, atol=1e-7)
 
 
-def test_aovs_give_the_color_and_its_variance(fog):
+def test_aovs_give_named_arrays_beside_the_color(fog):
     out = fog.render(**SMALL, spp=4, aovs=True)
-    assert set(out) == {"color", "variance"}
+    assert list(out) == ["color", "albedo", "normal", "depth", "variance"]
     assert np.array_equal(out["color"], fog.render(**SMALL, spp=4))
+    assert all(a.dtype == np.float32 for a in out.values())
     assert out["variance"].shape == (16, 24, 3) and (out["variance"] >= 0).all()
     assert out["variance"].max() > 0
+    assert out["depth"].shape == (16, 24) and out["albedo"].shape == out["normal"].shape == (16, 24, 3)
+    # Where the camera sees a surface, its normal is a unit vector (or the
+    # mean of a few), and its distance finite.
+    hit = np.isfinite(out["depth"])
+    assert 0 < hit.sum() < hit.size
+    lengths = np.linalg.norm(out["normal"][hit], axis=-1)
+    assert (lengths > 0).all() and (lengths < 1 + 1e-5).all()
+    assert (out["normal"][~hit] == 0).all()
+    # Only what is asked for, in the order asked.
+    some = fog.render(**SMALL, spp=4, aovs="depth, albedo")
+    assert list(some) == ["color", "depth", "albedo"]
+    assert np.array_equal(some["depth"], out["depth"])
+    assert list(fog.render(**SMALL, aovs=["normal"])) == ["color", "normal"]
+    with pytest.raises(ValueError, match="^aovs: unknown AOV `colour`; known: albedo, normal, depth, variance$"):
+        fog.render(**SMALL, aovs="colour")
+    with pytest.raises(ValueError, match="without shard"):
+        fog.render(**SMALL, aovs=True, shard=(0, 2))
 
 
 def test_at_time_moves_keyframed_lights_and_keeps_the_scene(tmp_path):

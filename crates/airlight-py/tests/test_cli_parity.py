@@ -6,7 +6,7 @@ import tomllib
 import numpy as np
 import pytest
 from conftest import SCENES
-from exr import read_exr
+from exr import read_channels, read_exr
 
 import airlight
 
@@ -83,3 +83,26 @@ def test_compare_prints_the_cli_figures(cli, tmp_path):
     for key in ("mean_a", "mean_b"):
         assert np.array_equal(np.float32(getattr(c, key)), np.float32(printed[key])), key
     assert c.as_dict()["rel_rmse"] == printed["rel_rmse"] > 0
+
+
+# The EXR layers `--aov` writes, by the names render(aovs=...) gives them.
+LAYERS = {
+    "albedo": ["albedo.R", "albedo.G", "albedo.B"],
+    "normal": ["N.X", "N.Y", "N.Z"],
+    "depth": ["Z"],
+    "variance": ["variance.R", "variance.G", "variance.B"],
+}
+
+
+@pytest.mark.parametrize("scene", ["spheres_point_fog.toml", "sdf_isometric.toml"])
+def test_aovs_equal_the_layers_the_cli_writes(cli, tmp_path, scene):
+    # sdf_isometric renders with `stochastic`, whose camera rays are stratified.
+    cli_render(cli, tmp_path, scene, "--aov", "albedo,normal,depth,variance", "--spp", "3")
+    channels = read_channels(tmp_path / "cli.exr")
+    out = airlight.load(SCENES / scene).render(**SIZE, spp=3, aovs=True)
+    assert np.array_equal(out["color"], np.stack([channels[c] for c in "RGB"], axis=-1))
+    for name, layer in LAYERS.items():
+        expected = np.stack([channels[c] for c in layer], axis=-1)
+        got = out[name] if out[name].ndim == 3 else out[name][..., None]
+        assert np.array_equal(got, expected), name
+    assert np.isfinite(out["depth"]).any() and out["albedo"].max() > 0

@@ -12,7 +12,7 @@ import airlight
 
 STUB = pathlib.Path(airlight.__file__).with_name("__init__.pyi")
 # Names only for type checkers: aliases, a Protocol and a TypedDict.
-TYPING_ONLY = {"Integrator", "Progress", "AOVs"}
+TYPING_ONLY = {"Integrator", "Progress", "AOV", "AOVs"}
 # render()'s film and control arguments; the other keywords are integrator options.
 FILM = {"integrator", "spp", "seed", "width", "height", "threads", "shard", "progress", "aovs"}
 
