@@ -200,8 +200,9 @@ class Scene:
         """
 
 def load(path: _Path) -> Scene:
-    """Reads a scene file as ``airlight render`` does; a bad one raises ``SceneError`` with the
-    CLI's message (``file:line:col: message``). Meshes are found in the file's folder, then in
+    """Reads a scene file, or a ``.gltf``/``.glb`` file as the scene of one ``[[include]]`` of
+    it, as ``airlight render`` does; a bad one raises ``SceneError`` with the CLI's message
+    (``file:line:col: message``). Meshes are found in the file's folder, then in
     the folders of ``AIRLIGHT_ASSET_PATH``."""
 
 def loads(text: str, base_dir: _Path | None = None) -> Scene:

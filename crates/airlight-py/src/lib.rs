@@ -16,7 +16,8 @@ use pyo3::prelude::*;
 use scene::{PyScene, Source};
 use std::path::PathBuf;
 
-/// Reads a scene file as `airlight render` does; errors are `SceneError`s
+/// Reads a scene file (or a `.gltf`/`.glb` file, as the scene of one
+/// `[[include]]` of it) as `airlight render` does; errors are `SceneError`s
 /// with the CLI's message (`file:line:col: message`). Meshes are found in
 /// the file's folder, then in those of `AIRLIGHT_ASSET_PATH`.
 #[pyfunction]
@@ -26,10 +27,14 @@ fn load(py: Python<'_>, path: PathBuf) -> PyResult<PyScene> {
         let file = py
             .detach(|| airlight::SceneFile::load_with(&path, &extra))
             .map_err(|e| errors::scene_error(py, &e, &Origin::File, ""))?;
-        // Kept for `Scene.toml` and `with_lights`; the library has just
-        // read it, within its size limit.
-        let text = std::fs::read_to_string(&path)
-            .map_err(|e| PyOSError::new_err(format!("cannot read `{}`: {e}", path.display())))?;
+        // Kept for `Scene.toml` and `with_lights`: the file, which the
+        // library has just read within its size limit, or for a glTF file
+        // the scene file the library reads it as.
+        let text = match path.file_name().filter(|_| is_gltf(&path)) {
+            Some(name) => format!("[[include]]\nfile = {}\n", toml::Value::from(name.to_string_lossy().into_owned())),
+            None => std::fs::read_to_string(&path)
+                .map_err(|e| PyOSError::new_err(format!("cannot read `{}`: {e}", path.display())))?,
+        };
         let assets = AssetPath::new(path.parent(), &extra);
         Ok(scene::new_scene(file, Source { text, assets, origin: Origin::File, file: Some(path) }))
     })
@@ -110,6 +115,11 @@ fn image(a: &PyArrayLikeDyn<'_, f32, AllowTypeChange>, what: &str) -> PyResult<a
         .map(|s| s.chunks_exact(3).map(|c| airlight::Rgb::new(c[0], c[1], c[2])).collect())
         .unwrap_or_default();
     Ok(airlight::Image { width: w as u32, height: h as u32, pixels })
+}
+
+/// Whether the library reads `path` as a glTF file, not a scene file.
+fn is_gltf(path: &std::path::Path) -> bool {
+    path.extension().is_some_and(|e| e.eq_ignore_ascii_case("gltf") || e.eq_ignore_ascii_case("glb"))
 }
 
 /// Refuses an image with pixels that are not finite numbers, as `airlight

@@ -184,3 +184,15 @@ def test_a_render_too_large_for_memory_is_refused_with_the_cli_message(cli, monk
     assert str(e.value) == expected.replace("(--width, --height)", "(width=, height=)")
     # A smaller image fits.
     assert airlight.load(SCENES / "spheres_point_fog.toml").render(**SMALL).shape == (16, 24, 3)
+
+
+def test_a_gltf_file_loads_as_the_scene_of_one_include(cli, tmp_path):
+    path = SCENES / "models/lamp_room.gltf"
+    scene = airlight.load(path)
+    assert scene.toml == '[[include]]\nfile = "lamp_room.gltf"\n' and scene.path == path
+    out = tmp_path / "cli.exr"
+    cli("render", path, "-o", out, "--width", 24, "--height", 16, "--quiet")
+    assert np.array_equal(scene.render(width=24, height=16), read_exr(out))
+    # Its text reads again, beside the file: a light added to the glTF's own.
+    lit = scene.with_lights([{"type": "point", "position": [0, 1, 0], "intensity": 5}])
+    assert lit.render(width=24, height=16).sum() > scene.render(width=24, height=16).sum()
