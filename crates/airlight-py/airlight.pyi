@@ -8,17 +8,31 @@ Images are linear RGB, ``float32`` arrays of shape (height, width, 3).
 import os
 import pathlib
 from collections.abc import Callable, Mapping, Sequence
-from typing import Any, Literal, Protocol, TypedDict, Union, overload
+from typing import Any, Literal, Protocol, TypedDict, Union, final, overload
 
 import numpy as np
 import numpy.typing as npt
 
 __version__: str
+__all__ = [
+    "__version__",
+    "Scene",
+    "Comparison",
+    "SceneError",
+    "IntegratorError",
+    "load",
+    "loads",
+    "from_dict",
+    "compare",
+    "read_exr",
+    "save",
+    "shard_samples",
+]
 
 _Path = Union[str, "os.PathLike[str]"]
 _Image = npt.NDArray[np.float32]
 _ArrayLike = npt.ArrayLike
-Integrator = Literal["direct", "raymarch", "analytic", "stochastic", "path", "radiosity"]
+_Integrator = Literal["direct", "raymarch", "analytic", "stochastic", "path", "radiosity"]
 
 class _Bar(Protocol):
     """What a progress bar must have: tqdm's ``update`` and ``total``."""
@@ -26,11 +40,11 @@ class _Bar(Protocol):
     total: Any
     def update(self, n: int) -> Any: ...
 
-Progress = Union[Callable[[int, int], Any], _Bar, bool, None]
+_Progress = Union[Callable[[int, int], Any], _Bar, bool, None]
 
-AOV = Literal["albedo", "normal", "depth", "variance"]
+_AOV = Literal["albedo", "normal", "depth", "variance"]
 
-class AOVs(TypedDict, total=False):
+class _AOVs(TypedDict, total=False):
     """``render(aovs=...)``'s arrays, float32, in the order asked for after ``color``; the
     same values as the layers ``airlight render --aov`` writes."""
 
@@ -68,6 +82,7 @@ class IntegratorError(ValueError):
     ``steps must be an integer from 1 to 1048576, got 0``), or an integrator that cannot
     render the scene (the message says why and what to use instead)."""
 
+@final
 class Comparison:
     """The figures ``airlight compare A.exr B.exr`` prints."""
 
@@ -85,6 +100,7 @@ class Comparison:
     mean_b: tuple[float, float, float]
     def as_dict(self) -> dict[str, Any]: ...
 
+@final
 class Scene:
     """A scene ready to render.
 
@@ -94,7 +110,7 @@ class Scene:
     ``at_time``, ``frame`` and ``with_lights`` return new ones.
     """
 
-    def __init__(self, scene: Mapping[str, Any], base_dir: _Path | None = None) -> None: ...
+    def __new__(cls, scene: Mapping[str, Any], base_dir: _Path | None = None) -> Scene: ...
     @property
     def width(self) -> int:
         """Image width the scene asks for; ``render(width=...)`` overrides it."""
@@ -106,7 +122,7 @@ class Scene:
     @property
     def seed(self) -> int: ...
     @property
-    def integrator(self) -> Integrator:
+    def integrator(self) -> _Integrator:
         """The integrator the scene names (``raymarch`` with a medium, else ``direct``)."""
     @property
     def time(self) -> float | None:
@@ -132,7 +148,7 @@ class Scene:
     @overload
     def render(
         self,
-        integrator: Integrator | None = None,
+        integrator: _Integrator | None = None,
         *,
         spp: int | None = None,
         seed: int | None = None,
@@ -140,7 +156,7 @@ class Scene:
         height: int | None = None,
         threads: int | None = None,
         shard: tuple[int, int] | None = None,
-        progress: Progress = None,
+        progress: _Progress = None,
         aovs: Literal[False] | None = None,
         steps: int = ...,
         jitter: bool = ...,
@@ -157,7 +173,7 @@ class Scene:
     @overload
     def render(
         self,
-        integrator: Integrator | None = None,
+        integrator: _Integrator | None = None,
         *,
         spp: int | None = None,
         seed: int | None = None,
@@ -165,8 +181,8 @@ class Scene:
         height: int | None = None,
         threads: int | None = None,
         shard: tuple[int, int] | None = None,
-        progress: Progress = None,
-        aovs: Literal[True] | str | Sequence[AOV],
+        progress: _Progress = None,
+        aovs: Literal[True] | str | Sequence[_AOV],
         steps: int = ...,
         jitter: bool = ...,
         shadows: bool = ...,
@@ -178,7 +194,7 @@ class Scene:
         bounces: int = ...,
         patch_size: float | None = ...,
         link_threshold: float = ...,
-    ) -> AOVs:
+    ) -> _AOVs:
         """Renders the scene: linear RGB, float32, shape (height, width, 3).
 
         ``integrator`` and the film arguments override the scene's ``[render]`` table; the
@@ -192,7 +208,7 @@ class Scene:
 
         ``aovs`` (True for all, or names: a list, or a comma-separated string) returns a dict
         of arrays instead, ``color`` first, then the AOVs asked for: ``albedo``, ``normal``,
-        ``depth`` and ``variance`` (see :class:`AOVs`); not with ``shard``.
+        ``depth`` and ``variance`` (see :class:`_AOVs`); not with ``shard``.
 
         As ``airlight render`` does, an image too large for the memory left (or for
         ``AIRLIGHT_MEMORY_LIMIT``) raises ``MemoryError`` before anything is allocated, and a
