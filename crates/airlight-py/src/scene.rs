@@ -1,0 +1,478 @@
+//! `airlight.Scene`: a scene read from a file, text or dicts, rendered into
+//! NumPy arrays.
+//!
+//! Scenes made from one another by `at_time` or `frame` share the Rust scene
+//! and the integrator last built for it, as the CLI's animations do: the
+//! integrator is built once for the lights as the file writes them, and a
+//! render at another time only moves the lights and tells the integrator
+//! (radiosity relights instead of recompiling). So two renders of such
+//! scenes take turns.
+
+use crate::errors::{Origin, guard, scene_error};
+use crate::options::{self, Film};
+use crate::render::{self, Job, Output, Progress};
+use airlight::SceneFile;
+use airlight::aov::Aov;
+use airlight::integrator::{Integrator, IntegratorDesc, IntegratorError, IntegratorKind};
+use airlight::light::Light;
+use airlight::scene::{AssetPath, RenderSettings, Scene};
+use numpy::ndarray::{Array2, Array3};
+use numpy::{PyArray2, PyArray3};
+use pyo3::exceptions::{PyMemoryError, PyUserWarning, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use std::path::{Path, PathBuf};
+use std::sync::{Arc, Mutex};
+
+/// Most worker threads a render starts, as `airlight render --threads`
+/// allows: spawning tens of thousands takes minutes before any work starts.
+const MAX_THREADS: i64 = 4096;
+
+/// Where the lights are: None as the file writes them (a still render),
+/// Some(t) at time t of the keyframes.
+pub type Pose = Option<f32>;
+
+/// The Rust scene and its integrator, shared by the scenes `at_time` makes.
+pub struct Shared {
+    pub scene: Scene,
+    /// The lights as the file writes them.
+    base_lights: Vec<Light>,
+    /// The pose the scene's lights are in; None while unknown (a panic
+    /// part way through moving them).
+    pose: Option<Pose>,
+    cache: Option<Cached>,
+}
+
+/// The integrator last built, what it was built from, and the pose it was
+/// last told of (None: unknown).
+struct Cached {
+    desc: IntegratorDesc,
+    /// Radiosity draws its patches' samples with the scene's seed.
+    seed: u64,
+    integrator: Box<dyn Integrator>,
+    pose: Option<Pose>,
+}
+
+impl Shared {
+    fn new(scene: Scene) -> Shared {
+        Shared { base_lights: scene.lights().to_vec(), scene, pose: Some(None), cache: None }
+    }
+
+    /// After a panic while the scene was held: rebuild what it changed.
+    pub fn forget(&mut self) {
+        self.pose = None;
+        self.cache = None;
+    }
+
+    /// Brings the lights to `pose` and the integrator `desc` to them,
+    /// building it if the cached one is of another description or seed.
+    pub fn prepare(&mut self, desc: IntegratorDesc, pose: Pose) -> Result<(), IntegratorError> {
+        let seed = self.scene.settings().seed;
+        if !matches!(&self.cache, Some(c) if c.desc == desc && c.seed == seed) {
+            self.cache = None;
+            // As `airlight render --frames` does: built for the file's
+            // lights, then moved to the frame.
+            self.move_lights(None);
+            let integrator = desc.build(&self.scene)?;
+            self.cache = Some(Cached { desc, seed, integrator, pose: Some(None) });
+        }
+        self.move_lights(pose);
+        let Some(cached) = self.cache.as_mut() else { unreachable!("built above") };
+        if cached.pose != Some(pose) {
+            cached.pose = None;
+            cached.integrator.lights_changed(&self.scene)?;
+            cached.pose = Some(pose);
+        }
+        Ok(())
+    }
+
+    fn move_lights(&mut self, pose: Pose) {
+        if self.pose == Some(pose) {
+            return;
+        }
+        self.pose = None;
+        // From the file's lights each time, so that a frame's lights do not
+        // depend on the frames rendered before it.
+        self.scene.set_lights(&self.base_lights);
+        if let Some(t) = pose {
+            self.scene.at_time(t);
+        }
+        self.pose = Some(pose);
+    }
+
+    /// The integrator [`Shared::prepare`] made ready.
+    pub fn integrator(&self) -> &dyn Integrator {
+        match &self.cache {
+            Some(c) => c.integrator.as_ref(),
+            None => unreachable!("prepare() builds the integrator before a render"),
+        }
+    }
+}
+
+/// A scene's text and where it came from, for `with_lights` and errors.
+pub struct Source {
+    pub text: String,
+    /// Where mesh files are found.
+    pub assets: AssetPath,
+    pub origin: Origin,
+    /// The file, for error messages.
+    pub file: Option<PathBuf>,
+}
+
+impl Source {
+    /// Text (`loads`, dicts): meshes are found in `base_dir` (None: the
+    /// current folder), then in the folders of `AIRLIGHT_ASSET_PATH`, as
+    /// the CLI finds a scene file's.
+    pub fn text(text: String, base_dir: Option<&Path>, origin: Origin) -> Source {
+        Source { text, assets: AssetPath::new(base_dir, &AssetPath::from_env()), origin, file: None }
+    }
+}
+
+/// What a scene holds, read once.
+struct Summary {
+    animated: bool,
+    lights: usize,
+    medium: bool,
+    /// Why every pixel will be black, if so: for integrators that ignore
+    /// the medium (`direct`), and for the others.
+    darkness: [Option<String>; 2],
+}
+
+/// A scene ready to render: read from a scene file (`airlight.load`), TOML
+/// text (`airlight.loads`) or dicts with the file's keys (`airlight.Scene(d)`).
+#[pyclass(name = "Scene", module = "airlight", frozen)]
+pub struct PyScene {
+    shared: Arc<Mutex<Shared>>,
+    source: Arc<Source>,
+    summary: Arc<Summary>,
+    settings: RenderSettings,
+    integrator: IntegratorDesc,
+    time: Option<f32>,
+}
+
+/// Reads a scene from its text; the GIL is released meanwhile (meshes may
+/// be large).
+pub fn read(py: Python<'_>, source: Source) -> PyResult<PyScene> {
+    let parsed = py.detach(|| SceneFile::from_toml_with(&source.text, &source.assets));
+    let file = parsed.map_err(|e| scene_error(py, &e, &source.origin, &source.text))?;
+    Ok(new_scene(file, source))
+}
+
+/// The Python scene of a scene file read from `source`.
+pub fn new_scene(file: SceneFile, source: Source) -> PyScene {
+    let SceneFile { scene, integrator } = file;
+    let summary = Summary {
+        animated: scene.is_animated(),
+        lights: scene.lights().len(),
+        medium: scene.medium().is_some(),
+        darkness: [scene.darkness(false), scene.darkness(true)],
+    };
+    PyScene {
+        settings: scene.settings().clone(),
+        integrator,
+        shared: Arc::new(Mutex::new(Shared::new(scene))),
+        source: Arc::new(source),
+        summary: Arc::new(summary),
+        time: None,
+    }
+}
+
+/// A scene from dicts: written as TOML and read as a file would be.
+pub fn from_dict(py: Python<'_>, scene: &Bound<'_, PyAny>, base_dir: Option<PathBuf>) -> PyResult<PyScene> {
+    let table = crate::dict::table(scene, "scene")?;
+    let text =
+        toml::to_string(&table).map_err(|e| PyValueError::new_err(format!("cannot write the scene as TOML: {e}")))?;
+    read(py, Source::text(text, base_dir.as_deref(), Origin::Dict))
+}
+
+impl PyScene {
+    fn at(&self, time: Option<f32>) -> PyScene {
+        PyScene {
+            shared: Arc::clone(&self.shared),
+            source: Arc::clone(&self.source),
+            summary: Arc::clone(&self.summary),
+            settings: self.settings.clone(),
+            integrator: self.integrator,
+            time,
+        }
+    }
+}
+
+/// A buffer of H·W RGB triples as an (H, W, 3) array; NumPy takes the
+/// buffer over, nothing is copied.
+fn array(py: Python<'_>, pixels: Vec<f32>, w: u32, h: u32) -> PyResult<Bound<'_, PyArray3<f32>>> {
+    let a = Array3::from_shape_vec((h as usize, w as usize, 3), pixels)
+        .map_err(|e| crate::errors::internal_error(&format!("image buffer: {e}")))?;
+    Ok(PyArray3::from_owned_array(py, a))
+}
+
+/// An image's pixels as an (H, W, 3) array.
+fn image_array<'py>(py: Python<'py>, image: &airlight::Image) -> PyResult<Bound<'py, PyArray3<f32>>> {
+    array(py, image.pixels.iter().flat_map(|p| p.to_array()).collect(), image.width, image.height)
+}
+
+/// The outputs `aovs=` asks for: True for all, or names (a list, or one
+/// comma-separated string); the library's message for an unknown one.
+fn aov_list(arg: Option<&Bound<'_, PyAny>>) -> PyResult<Vec<Aov>> {
+    let Some(arg) = arg.filter(|a| !a.is_none()) else { return Ok(Vec::new()) };
+    if let Ok(flag) = arg.cast::<pyo3::types::PyBool>() {
+        return Ok(if flag.is_true() { Aov::ALL.to_vec() } else { Vec::new() });
+    }
+    let list = if let Ok(s) = arg.cast::<pyo3::types::PyString>() {
+        s.to_cow()?.into_owned()
+    } else {
+        let names: Vec<String> = arg.extract().map_err(|_| {
+            pyo3::exceptions::PyTypeError::new_err(
+                "aovs must be True, False, a list of names or a comma-separated string of them \
+                 (albedo, normal, depth, variance)",
+            )
+        })?;
+        names.join(",")
+    };
+    Aov::parse_list(&list).map_err(|e| PyValueError::new_err(format!("aovs: {e}")))
+}
+
+#[pymethods]
+impl PyScene {
+    /// A scene from dicts with the scene file's keys (`render`, `camera`,
+    /// `materials`, `objects`, `lights`, `medium`), checked as a file is;
+    /// relative mesh paths start at `base_dir` (default: the current one).
+    #[new]
+    #[pyo3(signature = (scene, base_dir=None))]
+    fn new(py: Python<'_>, scene: &Bound<'_, PyAny>, base_dir: Option<PathBuf>) -> PyResult<PyScene> {
+        guard(|| from_dict(py, scene, base_dir))
+    }
+
+    /// Image width in pixels (the file's; `render(width=...)` overrides it).
+    #[getter]
+    fn width(&self) -> u32 {
+        self.settings.width
+    }
+
+    /// Image height in pixels (the file's; `render(height=...)` overrides it).
+    #[getter]
+    fn height(&self) -> u32 {
+        self.settings.height
+    }
+
+    /// Samples per pixel the file asks for.
+    #[getter]
+    fn spp(&self) -> u32 {
+        self.settings.spp
+    }
+
+    /// The seed of the scene's random numbers; `render(seed=...)` overrides it.
+    #[getter]
+    fn seed(&self) -> u64 {
+        self.settings.seed
+    }
+
+    /// The integrator the file names (or its default).
+    #[getter]
+    fn integrator(&self) -> &'static str {
+        self.integrator.kind.name()
+    }
+
+    /// The animation time this scene's lights are at, or None for the
+    /// lights as written.
+    #[getter]
+    fn time(&self) -> Option<f32> {
+        self.time
+    }
+
+    /// Whether any light has keyframes.
+    #[getter]
+    fn is_animated(&self) -> bool {
+        self.summary.animated
+    }
+
+    /// The scene as TOML text: the file read, or what a dict was written as.
+    #[getter]
+    fn toml(&self) -> &str {
+        &self.source.text
+    }
+
+    /// The scene file read (`load`), else None.
+    #[getter]
+    fn path(&self) -> Option<&Path> {
+        self.source.file.as_deref()
+    }
+
+    fn __repr__(&self) -> String {
+        let s = &self.settings;
+        let time = self.time.map(|t| format!(", time {t}")).unwrap_or_default();
+        format!(
+            "<airlight.Scene {}×{}, {} spp, {}, {} lights{}{time}>",
+            s.width,
+            s.height,
+            s.spp,
+            self.integrator.kind,
+            self.summary.lights,
+            if self.summary.medium { ", medium" } else { "" }
+        )
+    }
+
+    /// The scene with its keyframed lights at `time` in [0, 1] (held at the
+    /// end keys outside them); it shares this scene's integrator, so an
+    /// animation compiles radiosity once.
+    fn at_time(&self, time: f64) -> PyResult<PyScene> {
+        if !time.is_finite() {
+            return Err(PyValueError::new_err(format!("time must be a finite number, got {time}")));
+        }
+        Ok(self.at(Some(time as f32)))
+    }
+
+    /// Frame `k` of an `n`-frame animation, at time k/(n − 1) as
+    /// `airlight render --frames n --frame k` renders it.
+    fn frame(&self, k: u32, n: u32) -> PyResult<PyScene> {
+        if k >= n {
+            return Err(PyValueError::new_err(format!("frame {k}: the animation has frames 0 to {}", n as i64 - 1)));
+        }
+        Ok(self.at(Some(airlight::render::frame_time(k, n))))
+    }
+
+    /// The scene with other lights: a list of dicts as the file's
+    /// `[[lights]]` tables (keyframes too). The scene is read again from its
+    /// text with these lights, at the lights' written pose.
+    fn with_lights(&self, py: Python<'_>, lights: &Bound<'_, PyAny>) -> PyResult<PyScene> {
+        guard(|| {
+            let mut table: toml::Table = self
+                .source
+                .text
+                .parse()
+                .map_err(|e| crate::errors::internal_error(&format!("the scene's own text: {e}")))?;
+            table.insert("lights".into(), crate::dict::array(lights, "lights")?);
+            let text = toml::to_string(&table)
+                .map_err(|e| PyValueError::new_err(format!("cannot write the scene as TOML: {e}")))?;
+            let assets = self.source.assets.clone();
+            read(py, Source { text, assets, origin: Origin::Dict, file: None })
+        })
+    }
+
+    /// Renders the scene; returns linear RGB as a float32 array (height,
+    /// width, 3), the same pixels `airlight render` writes to an EXR.
+    ///
+    /// - `integrator`: direct, raymarch, analytic, stochastic, path or
+    ///   radiosity (default: the scene's).
+    /// - `spp`, `seed`, `width`, `height`: override the scene's `[render]`.
+    /// - `threads`: worker threads (default: every core); the image does
+    ///   not depend on it.
+    /// - `shard=(k, n)`: only the k-th of n ranges of each pixel's samples
+    ///   (`shard_samples`), as `airlight render --shard k/n`; the result is
+    ///   their mean.
+    /// - `progress`: a callable `f(done, total)` (pixel samples), a tqdm
+    ///   bar, or True for a new tqdm bar; called on this thread at most
+    ///   every 0.1 s. An exception it raises stops the render.
+    /// - `aovs`: True for all, or names (a list, or a comma-separated
+    ///   string): a dict of float32 arrays instead, `color` first, then
+    ///   `albedo`, `normal` (H, W, 3) and `depth` (H, W) of the first hits
+    ///   over the render's camera rays, and `variance` (of each pixel's
+    ///   mean), as asked: the layers `airlight render --aov` writes. Not
+    ///   with `shard`.
+    /// - Other keywords are integrator options by their scene-file names:
+    ///   steps, jitter, shadows, light_steps, light_quadrature, sampling,
+    ///   stratify, max_depth, bounces, patch_size, link_threshold; checked
+    ///   as the file checks them (`IntegratorError`).
+    ///
+    /// The GIL is released while rendering; Ctrl-C (looked for every 50 ms)
+    /// stops the render and raises KeyboardInterrupt. An image too large
+    /// for the memory left raises MemoryError; a scene that can only be
+    /// black gives a UserWarning, as the CLI warns.
+    #[pyo3(signature = (
+        integrator=None, *, spp=None, seed=None, width=None, height=None, threads=None,
+        shard=None, progress=None, aovs=None, **options
+    ))]
+    #[allow(clippy::too_many_arguments)]
+    fn render<'py>(
+        &self,
+        py: Python<'py>,
+        integrator: Option<&Bound<'py, PyAny>>,
+        spp: Option<&Bound<'py, PyAny>>,
+        seed: Option<&Bound<'py, PyAny>>,
+        width: Option<&Bound<'py, PyAny>>,
+        height: Option<&Bound<'py, PyAny>>,
+        threads: Option<i64>,
+        shard: Option<(i64, i64)>,
+        progress: Option<&Bound<'py, PyAny>>,
+        aovs: Option<&Bound<'py, PyAny>>,
+        options: Option<&Bound<'py, PyDict>>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        guard(|| {
+            let settings = Film { spp, seed, width, height }.apply(&self.settings)?;
+            let desc = options::integrator(self.integrator, integrator, options)?;
+            let threads = match threads {
+                None => 0,
+                Some(n) if (1..=MAX_THREADS).contains(&n) => n as usize,
+                Some(n) => {
+                    return Err(PyValueError::new_err(format!(
+                        "threads must be an integer from 1 to {MAX_THREADS}, got {n}"
+                    )));
+                }
+            };
+            let spp = settings.spp as u64;
+            let samples = match shard {
+                None => 0..spp,
+                Some((k, n)) if !(0 <= k && k < n) => {
+                    return Err(PyValueError::new_err(format!("shard (k, n) needs 0 ≤ k < n, got ({k}, {n})")));
+                }
+                Some((_, n)) if n as u64 > spp => {
+                    return Err(PyValueError::new_err(format!(
+                        "shard (k, {n}): the render has only {spp} samples per pixel, so at most {spp} shards"
+                    )));
+                }
+                Some((k, n)) => airlight::film::partial::piece(spp, k as u64, n as u64),
+            };
+            let aovs = aov_list(aovs)?;
+            if !aovs.is_empty() && shard.is_some() {
+                return Err(PyValueError::new_err(
+                    "aovs: a shard holds part of the samples; render the AOVs without shard, as \
+                     `airlight render --aov` refuses --shard",
+                ));
+            }
+            let variance = aovs.contains(&Aov::Variance);
+            let surface = aovs.iter().any(|a| *a != Aov::Variance);
+            // As the CLI does before it renders: an image too large for
+            // memory is refused, a scene that can only be black is warned of.
+            let pixels = settings.width as u64 * settings.height as u64;
+            let what = format!("a {}×{} render", settings.width, settings.height);
+            airlight::memory::check(what, airlight::memory::render_bytes(pixels, variance))
+                .map_err(|e| PyMemoryError::new_err(format!("{e}: make the image smaller (width=, height=)")))?;
+            let sees_medium = desc.kind != IntegratorKind::Direct;
+            if let Some(why) = &self.summary.darkness[sees_medium as usize] {
+                let message = std::ffi::CString::new(why.as_str()).unwrap_or_default();
+                PyErr::warn(py, &py.get_type::<PyUserWarning>(), &message, 1)?;
+            }
+            let label =
+                format!("{} {}×{} {} spp", desc.kind, settings.width, settings.height, samples.end - samples.start);
+            let progress = Progress::from_arg(py, progress, &label)?;
+            let (w, h) = (settings.width, settings.height);
+            // A scene without keyframes is the same at every time.
+            let pose = self.time.filter(|_| self.summary.animated);
+            let shared = Arc::clone(&self.shared);
+            let job = Job { shared, settings, desc, pose, samples, threads, variance, surface };
+            let Output { color, mut variance, mut surface } = render::run(py, job, progress)?;
+            let color = array(py, color, w, h)?;
+            if aovs.is_empty() {
+                return Ok(color.into_any());
+            }
+            let out = PyDict::new(py);
+            out.set_item("color", color)?;
+            for aov in aovs {
+                let missing = || crate::errors::internal_error(&format!("{} was not rendered", aov.name()));
+                let value = match aov {
+                    Aov::Variance => array(py, variance.take().ok_or_else(missing)?, w, h)?.into_any(),
+                    Aov::Albedo => image_array(py, &surface.as_ref().ok_or_else(missing)?.albedo)?.into_any(),
+                    Aov::Normal => image_array(py, &surface.as_ref().ok_or_else(missing)?.normal)?.into_any(),
+                    Aov::Depth => {
+                        let depth = std::mem::take(&mut surface.as_mut().ok_or_else(missing)?.depth);
+                        let depth = Array2::from_shape_vec((h as usize, w as usize), depth)
+                            .map_err(|e| crate::errors::internal_error(&format!("depth buffer: {e}")))?;
+                        PyArray2::from_owned_array(py, depth).into_any()
+                    }
+                };
+                out.set_item(aov.name(), value)?;
+            }
+            Ok(out.into_any())
+        })
+    }
+}
