@@ -8,9 +8,8 @@
 
 use crate::Rgb;
 use crate::film::Image;
-use crate::geometry::Ray;
-use crate::scene::{PixelFilter, Scene};
-use glam::{Vec2, Vec3};
+use crate::scene::Scene;
+use glam::Vec3;
 use rayon::prelude::*;
 use std::ops::Range;
 
@@ -108,7 +107,9 @@ pub fn surface_aovs(scene: &Scene, stratified: bool, samples: Range<u64>) -> Sur
             let (x, y) = ((index % width as usize) as u32, (index / width as usize) as u32);
             let (mut albedo, mut normal, mut depth, mut hits) = (Rgb::ZERO, Vec3::ZERO, 0.0f64, 0u64);
             for i in samples.clone() {
-                let ray = camera_ray(scene, stratified, x, y, i);
+                let index = y as u64 * width as u64 + x as u64;
+                let mut sampler = crate::sampling::Sampler::for_pixel(s.seed, index, i);
+                let ray = crate::render::camera_ray(scene, stratified, x, y, &mut sampler);
                 let Some(hit) = scene.geometry().intersect(&ray, f32::INFINITY) else { continue };
                 let surface = scene.geometry().surface(&ray, hit);
                 if surface.emitter.is_none() {
@@ -128,25 +129,6 @@ pub fn surface_aovs(scene: &Scene, stratified: bool, samples: Range<u64>) -> Sur
         normal: Image { width, height, pixels: pixels.iter().map(|p| p.1).collect() },
         depth: pixels.iter().map(|p| p.2).collect(),
     }
-}
-
-/// The camera ray of sample `i` of pixel (x, y), drawn as
-/// [`crate::render::pixel_sum`] draws it.
-fn camera_ray(scene: &Scene, stratified: bool, x: u32, y: u32, i: u64) -> Ray {
-    let s = scene.settings();
-    let mut sampler = crate::sampling::Sampler::for_pixel(s.seed, y as u64 * s.width as u64 + x as u64, i);
-    let (jitter, lens) = if stratified {
-        let u = sampler.stratified4(0);
-        (Vec2::new(u[0], u[1]), Vec2::new(u[2], u[3]))
-    } else {
-        (sampler.next2(), sampler.next2())
-    };
-    let film = Vec2::new(x as f32, y as f32)
-        + match s.filter {
-            PixelFilter::Box => jitter,
-            PixelFilter::Point => Vec2::splat(0.5),
-        };
-    scene.camera().ray(film, s.width, s.height, lens)
 }
 
 #[cfg(test)]

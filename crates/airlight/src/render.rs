@@ -119,21 +119,31 @@ pub fn pixel_sum(scene: &Scene, integrator: &dyn Integrator, x: u32, y: u32, sam
     let mut sum = PixelSum::default();
     for i in samples {
         let mut sampler = Sampler::for_pixel(s.seed, index, i);
-        let (jitter, lens) = if integrator.stratified() {
-            let u = sampler.stratified4(0);
-            (Vec2::new(u[0], u[1]), Vec2::new(u[2], u[3]))
-        } else {
-            (sampler.next2(), sampler.next2())
-        };
-        let film = Vec2::new(x as f32, y as f32)
-            + match s.filter {
-                PixelFilter::Box => jitter,
-                PixelFilter::Point => Vec2::splat(0.5),
-            };
-        let ray = scene.camera().ray(film, s.width, s.height, lens);
+        let ray = camera_ray(scene, integrator.stratified(), x, y, &mut sampler);
         sum.add(integrator.radiance(scene, &ray, &mut sampler));
     }
     sum
+}
+
+/// The camera ray of a sample of pixel (x, y), drawn from the sample's
+/// `sampler` first (its anti-aliasing and lens numbers; from the pixel's
+/// stratified sequence when `stratified`, see
+/// [`Integrator::stratified`]), so that the AOVs ([`crate::aov`]) trace
+/// exactly the render's rays.
+pub fn camera_ray(scene: &Scene, stratified: bool, x: u32, y: u32, sampler: &mut Sampler) -> crate::geometry::Ray {
+    let s = scene.settings();
+    let (jitter, lens) = if stratified {
+        let u = sampler.stratified4(0);
+        (Vec2::new(u[0], u[1]), Vec2::new(u[2], u[3]))
+    } else {
+        (sampler.next2(), sampler.next2())
+    };
+    let film = Vec2::new(x as f32, y as f32)
+        + match s.filter {
+            PixelFilter::Box => jitter,
+            PixelFilter::Point => Vec2::splat(0.5),
+        };
+    scene.camera().ray(film, s.width, s.height, lens)
 }
 
 /// Moves `scene` to `time` in [0, 1] of its light animation and tells

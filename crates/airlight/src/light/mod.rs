@@ -185,6 +185,17 @@ impl Light {
         Light::Triangle { a, edge_1: b - a, edge_2: c - a, radiance }
     }
 
+    /// The triangle lights of an emitting mesh, one per triangle that has
+    /// an area in f32 (degenerate ones emit nothing and are left out).
+    pub fn triangles_of(positions: &[Vec3], triangles: &[[u32; 3]], radiance: Rgb) -> Vec<Light> {
+        triangles
+            .iter()
+            .map(|t| t.map(|i| positions[i as usize]))
+            .filter(|[a, b, c]| (*b - *a).cross(*c - *a).length_squared().is_normal())
+            .map(|[a, b, c]| Light::triangle(a, b, c, radiance))
+            .collect()
+    }
+
     pub fn line(start: Vec3, end: Vec3, intensity: Rgb) -> Self {
         Light::Line { start, end, intensity }
     }

@@ -525,18 +525,8 @@ impl Checker<'_> {
         match shape {
             Shape::Sphere { center, radius } => Ok(vec![Light::sphere(center, radius, radiance)]),
             Shape::Quad { corner, edge_u, edge_v } => Ok(vec![Light::quad(corner, edge_u, edge_v, radiance)]),
-            Shape::Mesh { positions, triangles } => {
-                let mut lights = Vec::new();
-                lights.try_reserve_exact(triangles.len()).map_err(|_| {
-                    self.err(span.clone(), format!("{label}: no memory for {} triangle lights", triangles.len()))
-                })?;
-                for [a, b, c] in triangles.iter().map(|t| t.map(|i| positions[i as usize])) {
-                    if (b - a).cross(c - a).length_squared().is_normal() {
-                        lights.push(Light::triangle(a, b, c, radiance));
-                    }
-                }
-                Ok(lights)
-            }
+            // The mesh's memory was checked when it was read.
+            Shape::Mesh { positions, triangles } => Ok(Light::triangles_of(&positions, &triangles, radiance)),
             _ => Err(self.err_field(
                 span,
                 "emission",

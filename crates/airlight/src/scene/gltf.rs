@@ -201,11 +201,7 @@ impl Checker<'_> {
                 return Err(format!("{at}: its material's emission is not finite and ≥ 0: {emission}"));
             }
             if emission.max_element() > 0.0 && include.material.is_none() {
-                for [a, b, c] in triangles.iter().map(|t| t.map(|i| positions[i as usize])) {
-                    if (b - a).cross(c - a).length_squared().is_normal() {
-                        out.built.lights.push(Light::triangle(a, b, c, emission));
-                    }
-                }
+                out.built.lights.extend(Light::triangles_of(&positions, &triangles, emission));
                 continue;
             }
             let name = match include.material {
