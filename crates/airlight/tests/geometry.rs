@@ -233,7 +233,19 @@ fn axis_aligned_rays_find_flat_quads_through_the_bvh() {
 #[test]
 fn bvh_agrees_with_brute_force_in_the_lamp_room() {
     // A real scene: glTF meshes, boxes and quads sharing edges and faces.
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/gltf_lamp_room_fog.toml");
+    bvh_agrees_with_brute_force_in("gltf_lamp_room_fog.toml", 5000);
+}
+
+#[test]
+fn bvh_agrees_with_brute_force_in_the_cornell_box() {
+    // Eight primitives (quads and rotated boxes), one per BVH leaf.
+    bvh_agrees_with_brute_force_in("compare_cornell.toml", 8000);
+}
+
+/// Random rays through a scene file's geometry: the BVH's nearest hit
+/// distance and occlusion against testing every primitive.
+fn bvh_agrees_with_brute_force_in(scene: &str, min_hits: u32) {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes").join(scene);
     let scene = airlight::SceneFile::load(&path).expect("scene loads").scene;
     let geometry = scene.geometry();
     let (lo, hi) = geometry.bounds().expect("bounded geometry");
@@ -251,7 +263,7 @@ fn bvh_agrees_with_brute_force_in_the_lamp_room() {
         hits += slow.is_some() as u32;
         ties += (fast != slow) as u32;
     }
-    assert!(hits > 5000, "hits {hits}");
+    assert!(hits > min_hits, "hits {hits}");
     // Equal distances to two primitives (a shared edge) may name either:
     // the distances agree (asserted above), the primitive may not.
     eprintln!("{hits} hits, {ties} at a tie named another primitive");

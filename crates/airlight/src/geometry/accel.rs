@@ -196,7 +196,9 @@ pub struct Geometry {
 }
 
 /// Up to this many primitives are tested one by one, without the BVH.
-const LINEAR_LIMIT: usize = 8;
+const LINEAR_LIMIT: usize = 2;
+/// Up to this many primitives, the BVH's leaves hold one primitive each.
+const SMALL_SCENE: usize = 64;
 
 impl std::fmt::Debug for Geometry {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
@@ -280,7 +282,14 @@ impl GeometryBuilder {
             let triangles = triangles_of(&records);
             return Geometry { records, planes, unbounded, triangles, bvh: None, bounds };
         }
-        let bvh2 = obvhs::bvh2::builder::build_bvh2(&records, BvhBuildParams::medium_build(), &mut Duration::default());
+        let mut params = BvhBuildParams::medium_build();
+        if records.len() <= SMALL_SCENE {
+            // One primitive per leaf: in a room of a few quads and boxes the
+            // boxes' SIMD test spares most primitive tests, where a leaf of
+            // eight (obvhs's choice for meshes) would test them all.
+            params.max_prims_per_leaf = 1;
+        }
+        let bvh2 = obvhs::bvh2::builder::build_bvh2(&records, params, &mut Duration::default());
         // Reorder so that the tree's leaf ranges index `records` directly.
         let records: Vec<Record> = bvh2.primitive_indices.iter().map(|&i| records[i as usize].clone()).collect();
         let triangles = triangles_of(&records);
