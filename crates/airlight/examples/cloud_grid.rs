@@ -53,15 +53,8 @@ fn main() -> std::io::Result<()> {
 /// 3 with noisy edges, empty corners.
 fn write_small_cloud(out: &str) -> std::io::Result<()> {
     let n = 32;
-    let noise = NoiseFog {
-        scale: Vec3::splat(0.6),
-        octaves: 3,
-        gain: 0.5,
-        offset: 0.0,
-        seed: 5,
-        bounds: None,
-        height: None,
-    };
+    let noise =
+        NoiseFog { scale: Vec3::splat(0.6), octaves: 3, gain: 0.5, offset: 0.0, seed: 5, bounds: None, height: None };
     let mut values = Vec::with_capacity(n * n * n);
     for z in 0..n {
         for y in 0..n {

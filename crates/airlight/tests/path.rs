@@ -37,8 +37,11 @@ fn white_furnace_gives_the_wall_radiance_everywhere() {
         Medium::homogeneous(Rgb::ZERO, Rgb::splat(1.5), 0.7),
         Medium::height(Rgb::ZERO, Rgb::new(0.8, 0.4, 1.2), -0.3, -1.0, 0.9),
     ] {
-        let image =
-            render(&furnace(medium.clone()), &PathTracer::new(PathOptions { max_depth: 10_000 }), &RenderObserver::none());
+        let image = render(
+            &furnace(medium.clone()),
+            &PathTracer::new(PathOptions { max_depth: 10_000 }),
+            &RenderObserver::none(),
+        );
         // The image mean against 1, within four standard errors (measured
         // from the spread of the pixels, which are independent).
         let mean = image.mean();
