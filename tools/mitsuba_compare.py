@@ -9,7 +9,8 @@
 For each scene it translates the TOML file into a Mitsuba 3 scene (the
 subset of the schema the comparison scenes use: perspective camera, quad,
 sphere, box and plane objects, diffuse materials, point, spot, quad and
-sphere lights, a homogeneous medium filling space), renders it with
+sphere lights, a homogeneous medium filling space or a density grid with
+a grey extinction), renders it with
 Mitsuba's `volpath` (or `path` in vacuum), renders it with `airlight render
 --integrator path` at the same size and sample count, and prints
 `airlight compare` of the two, plus the noise floors: each renderer
@@ -102,8 +103,9 @@ def translate(path, spp):
     scene = {"type": "scene"}
     ext = {}
     if medium:
-        if medium.get("type", "homogeneous") != "homogeneous":
-            raise SystemExit(f"{path}: only homogeneous media translate to Mitsuba here")
+        kind = medium.get("type", "homogeneous")
+        if kind not in ("homogeneous", "grid"):
+            raise SystemExit(f"{path}: only homogeneous and grid media translate to Mitsuba here")
         sa, ss = colour(medium.get("sigma_a")), colour(medium.get("sigma_s"))
         st = [a + b for a, b in zip(sa, ss)]
         scene["fog"] = {
@@ -113,6 +115,16 @@ def translate(path, spp):
             "albedo": {"type": "rgb", "value": [b / t if t > 0 else 0.0 for b, t in zip(ss, st)]},
             "phase": {"type": "hg", "g": float(medium.get("g", 0.0))},
         }
+        if kind == "grid":
+            # Mitsuba's heterogeneous medium: one extinction (the grid times
+            # `scale`), so σt must be grey; the .vol's box placed by the
+            # medium's transform, as Airlight places it.
+            if max(st) - min(st) > 1e-6 * max(st):
+                raise SystemExit(f"{path}: a grid compares with Mitsuba only with a grey sigma_a + sigma_s")
+            grid = {"type": "gridvolume", "filename": os.path.join(os.path.dirname(path), medium["file"]),
+                    "use_grid_bbox": True, "to_world": object_transform(medium)}
+            scene["fog"].update({"type": "heterogeneous", "sigma_t": grid,
+                                 "scale": st[0] * float(medium.get("density_scale", 1.0))})
         ext = {"exterior": {"type": "ref", "id": "fog"}, "interior": {"type": "ref", "id": "fog"}}
     if r.get("integrator") == "direct":
         scene["integrator"] = {"type": "direct", "emitter_samples": 1, "bsdf_samples": 0}

@@ -10,7 +10,6 @@ use crate::Rgb;
 use crate::geometry::Shape;
 use crate::light::Light;
 use crate::material::Material;
-use crate::medium::Medium;
 use glam::{Affine3A, Quat, Vec3};
 use std::cell::{Cell, RefCell};
 use std::ops::Range;
@@ -260,34 +259,6 @@ impl Checker<'_> {
             ));
         }
         Ok(())
-    }
-
-    fn medium(&self, desc: &Spanned<MediumDesc>) -> Result<Medium> {
-        let span = desc.span();
-        let m = desc.get_ref();
-        let sigma_a = self.non_negative3(span.clone(), "medium.sigma_a", m.sigma_a.map_or(Vec3::ZERO, |t| t.0))?;
-        let sigma_s = self.non_negative3(span.clone(), "medium.sigma_s", m.sigma_s.map_or(Vec3::ZERO, |t| t.0))?;
-        let g = m.g.unwrap_or(0.0);
-        if !(g > -1.0 && g < 1.0) {
-            return Err(self.err_field(span, "g", format!("medium.g must lie strictly between -1 and 1, got {g}")));
-        }
-        match m.kind {
-            MediumType::Homogeneous => {
-                if m.base.is_some() || m.falloff.is_some() {
-                    return Err(self.err_field(
-                        span,
-                        if m.base.is_some() { "base" } else { "falloff" },
-                        "base and falloff belong to a `height` medium, not a homogeneous one",
-                    ));
-                }
-                Ok(Medium::homogeneous(sigma_a, sigma_s, g))
-            }
-            MediumType::Height => {
-                let base = self.finite(span.clone(), "medium.base", m.base.unwrap_or(0.0))?;
-                let falloff = self.non_negative(span, "medium.falloff", m.falloff.unwrap_or(0.5))?;
-                Ok(Medium::height(sigma_a, sigma_s, g, base, falloff))
-            }
-        }
     }
 
     fn material(&self, name: &str, desc: &Spanned<MaterialDesc>) -> Result<Material> {

@@ -12,6 +12,7 @@ pub mod assets;
 mod build;
 mod build_camera;
 mod build_lights;
+mod build_medium;
 pub mod desc;
 mod error;
 mod gltf;

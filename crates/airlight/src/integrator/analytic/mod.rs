@@ -204,12 +204,18 @@ impl Analytic {
                         use raymarch or stochastic, or render without shadows"
                 .into());
         }
-        if let Some(m) = scene.medium()
-            && let Density::Height { .. } = m.density
-        {
-            return Err("the analytic integrator needs a homogeneous medium; \
-                        this scene's is height fog: use raymarch"
-                .into());
+        if let Some(m) = scene.medium() {
+            let kind = match m.density {
+                Density::Homogeneous => None,
+                Density::Height { .. } => Some("height fog"),
+                Density::Grid(_) => Some("a density grid"),
+                Density::Noise(_) => Some("noise fog"),
+            };
+            if let Some(kind) = kind {
+                return Err(format!(
+                    "the analytic integrator needs a homogeneous medium; this scene's is {kind}: use raymarch"
+                ));
+            }
         }
         if options.light_steps == 0 {
             return Err("light_steps must be at least 1".into());
