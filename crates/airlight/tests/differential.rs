@@ -287,7 +287,9 @@ fn check(seed: u64) -> Result<Vec<(&'static str, f64)>, String> {
     }
     if scene.medium().is_none() {
         let path = render(&mut scene, IntegratorKind::Path, 512, 3)?;
-        let options = RadiosityOptions { bounces: 2, patch_size: Some(PATCH_SIZE), ..Default::default() };
+        let patch_size =
+            std::env::var("AIRLIGHT_DIFF_PATCH_SIZE").ok().and_then(|s| s.parse().ok()).unwrap_or(PATCH_SIZE);
+        let options = RadiosityOptions { bounces: 2, patch_size: Some(patch_size), ..Default::default() };
         let solved = RadiosityIntegrator::new(&scene, options, Default::default()).map_err(|e| e.to_string())?;
         scene.settings_mut().spp = 16;
         let radiosity = accumulate(&scene, &solved, 0..16, 0..SIZE, &Default::default());

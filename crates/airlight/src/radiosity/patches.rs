@@ -12,7 +12,9 @@
 //! edge is longer than `h` = `patch_size`; a triangle into n² similar
 //! triangles with n = ⌈longest edge / h⌉; a box into its six faces, each cut
 //! as a quad; a sphere into a latitude–longitude grid with ⌈πr/h⌉ bands;
-//! an infinite plane is clipped to a square (see [`plane_square`]).
+//! an infinite plane is cut in a square (see [`plane_square`]) and in
+//! coarser rings around it out to 64 times its size (see
+//! [`PLANE_RINGS`]).
 
 use crate::geometry::Shape;
 use glam::{Affine3A, Mat3, Vec3};
@@ -107,6 +109,7 @@ pub fn cut(
         Shape::Plane { point, normal } => {
             let (corner, u, v) = plane_square(*point, *normal, center, half);
             cut_quad(corner, u, v, h, true, out);
+            cut_plane_rings(corner + 0.5 * (u + v), 0.5 * u, 0.5 * v, out);
         }
         Shape::Box { min, max } => cut_box(*min, *max, h, inner, out),
         Shape::Sphere { center, radius } => cut_sphere(*center, *radius, h, inner, out),
@@ -140,7 +143,7 @@ pub fn count(shape: &Shape, h: f32, (center, half): (Vec3, f32)) -> f64 {
         Shape::Quad { edge_u, edge_v, .. } => 2.0 * quad(*edge_u, *edge_v),
         Shape::Plane { point, normal } => {
             let (_, u, v) = plane_square(*point, *normal, center, half);
-            2.0 * quad(u, v)
+            2.0 * (quad(u, v) + (PLANE_RINGS * RING_CELLS) as f64)
         }
         Shape::Box { min, max } => {
             let d = *max - *min;
@@ -239,6 +242,41 @@ fn cut_quad(corner: Vec3, u: Vec3, v: Vec3, h: f32, two_sided: bool, out: &mut V
         for j in 0..nv {
             let shape = PatchShape { origin: corner + du * i as f32 + dv * j as f32, e1: du, e2: dv, triangle: false };
             push_flat(shape, n, two_sided, out);
+        }
+    }
+}
+
+/// How many square rings of coarse patches surround a plane's square,
+/// each twice as wide as the one inside it: out to 2⁶ = 64 times the
+/// square's half side.
+pub const PLANE_RINGS: u32 = 6;
+/// Patches per ring (per side): an 8 × 8 grid less its 4 × 4 middle.
+const RING_CELLS: u32 = 48;
+
+/// Cuts the rings around a plane's square (centre `c`, half sides `hu`,
+/// `hv`): ring k spans 2^(k−1) to 2^k half sides, as 48 patches of a
+/// quarter of its width, two-sided. The light an infinite plane sends up
+/// from beyond a distance D falls only as h/(2D) on a wall at height h
+/// facing along it, so a square around the objects alone misses much of a
+/// sunlit floor's bounce (a box's side 3 units above the floor got a fifth
+/// of the path tracer's light, the differential test's seed 3122); far
+/// away the floor's light is smooth, so patches as large as their distance
+/// over two suffice there.
+fn cut_plane_rings(c: Vec3, hu: Vec3, hv: Vec3, out: &mut Vec<Patch>) {
+    let n = hu.cross(hv).normalize();
+    for k in 1..=PLANE_RINGS {
+        let scale = (1u32 << k) as f32;
+        let (du, dv) = (hu * scale / 4.0, hv * scale / 4.0);
+        let corner = c - (hu + hv) * scale;
+        for i in 0..8 {
+            for j in 0..8 {
+                if (2..6).contains(&i) && (2..6).contains(&j) {
+                    continue;
+                }
+                let shape =
+                    PatchShape { origin: corner + du * i as f32 + dv * j as f32, e1: du, e2: dv, triangle: false };
+                push_flat(shape, n, true, out);
+            }
         }
     }
 }
