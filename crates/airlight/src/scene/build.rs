@@ -54,6 +54,7 @@ pub fn build(desc: &SceneDesc, text: &str, assets: &AssetPath) -> Result<Scene, 
         files: RefCell::default(),
         mesh_bytes: Cell::new(0),
         notes: RefCell::default(),
+        textures: RefCell::default(),
     };
     let mut scene = checker.scene(desc)?;
     scene.files = checker.files.into_inner();
@@ -71,6 +72,8 @@ pub(super) struct Checker<'a> {
     pub(super) mesh_bytes: Cell<u64>,
     /// What was asked for and is not done (see [`Scene::notes`]).
     pub(super) notes: RefCell<Vec<String>>,
+    /// Image files read as textures, so that each is read once.
+    pub(super) textures: RefCell<Vec<(PathBuf, std::sync::Arc<crate::texture::Texture>)>>,
 }
 
 pub(super) type Result<T, E = SceneError> = std::result::Result<T, E>;
@@ -312,6 +315,27 @@ impl Checker<'_> {
             misplaced(m.specular.is_some(), "specular", "phong")?;
             misplaced(m.exponent.is_some(), "exponent", "phong")?;
         }
+        if m.kind != MaterialType::Texture {
+            misplaced(m.file.is_some(), "file", "texture")?;
+            misplaced(m.wrap.is_some(), "wrap", "texture")?;
+        }
+        if m.kind == MaterialType::Texture {
+            let Some(file) = &m.file else {
+                return Err(self.err(span, format!("materials.{name}: a texture material needs a `file` (an image)")));
+            };
+            let factor = albedo(m.albedo, "albedo", 1.0)?;
+            let texture = self.texture_file(file.get_ref()).map_err(|why| {
+                self.err(file.span(), format!("materials.{name}.file: cannot load the texture: {why}"))
+            })?;
+            let texture = match &m.wrap {
+                Some(w) => {
+                    let wrap = desc::parse_name(w, &what("wrap")).map_err(|e| self.err(e.span, e.message))?;
+                    std::sync::Arc::new((*texture).clone().with_wrap(wrap, wrap))
+                }
+                None => texture,
+            };
+            return Ok(Material::textured(factor, texture));
+        }
         let a = albedo(m.albedo, "albedo", 0.8)?;
         Ok(match m.kind {
             MaterialType::Diffuse => Material::diffuse(a),
@@ -325,6 +349,7 @@ impl Checker<'_> {
                 let exponent = self.non_negative(span, &what("exponent"), m.exponent.unwrap_or(32.0))?;
                 Material::phong(a, specular, exponent)
             }
+            MaterialType::Texture => unreachable!("returned above"),
         })
     }
 
@@ -464,21 +489,12 @@ impl Checker<'_> {
                 }
                 None => self.mesh_with_materials(span, &label, &d.file, transform)?,
             };
-            return Ok(gltf::Imported { built, camera: None, textures_skipped: 0 });
+            return Ok(gltf::Imported { built, camera: None });
         }
         if !(file.ends_with(".gltf") || file.ends_with(".glb")) {
             return Err(self.err(d.file.span(), format!("{label}: `file` must be a .gltf, .glb or .obj file")));
         }
-        let imported =
-            self.gltf(&gltf::Include { label: &label, file: &d.file, scene: d.scene.as_deref(), transform, material })?;
-        if imported.textures_skipped > 0 {
-            self.notes.borrow_mut().push(format!(
-                "{label}: {} primitives have a base-colour texture, which Airlight does not read yet; \
-                 they take their base colour factor",
-                imported.textures_skipped
-            ));
-        }
-        Ok(imported)
+        self.gltf(&gltf::Include { label: &label, file: &d.file, scene: d.scene.as_deref(), transform, material })
     }
 
     /// A mesh object without a `material`: its faces take the `.mtl`
@@ -495,6 +511,7 @@ impl Checker<'_> {
         let only_part = parts.len() == 1;
         let mut built = Built::default();
         for part in parts {
+            let texture = part.texture;
             let Some(m) = part.material else {
                 let why = if only_part {
                     "(a name from [materials]), or faces with `usemtl` materials from an `mtllib`"
@@ -510,7 +527,12 @@ impl Checker<'_> {
                 }
                 _ => {
                     let name = format!("{}:{}", file.get_ref(), m.name);
-                    built.materials.push((name.clone(), Material::diffuse(m.diffuse.unwrap_or(Vec3::splat(0.8)))));
+                    let material = match texture {
+                        // The MTL convention: the map scaled by Kd (1 when absent).
+                        Some(t) => Material::textured(m.diffuse.unwrap_or(Vec3::ONE), t),
+                        None => Material::diffuse(m.diffuse.unwrap_or(Vec3::splat(0.8))),
+                    };
+                    built.materials.push((name.clone(), material));
                     built.objects.push((placed, name));
                 }
             }
@@ -526,7 +548,7 @@ impl Checker<'_> {
             Shape::Sphere { center, radius } => Ok(vec![Light::sphere(center, radius, radiance)]),
             Shape::Quad { corner, edge_u, edge_v } => Ok(vec![Light::quad(corner, edge_u, edge_v, radiance)]),
             // The mesh's memory was checked when it was read.
-            Shape::Mesh { positions, triangles } => Ok(Light::triangles_of(&positions, &triangles, radiance)),
+            Shape::Mesh { positions, triangles, .. } => Ok(Light::triangles_of(&positions, &triangles, radiance)),
             _ => Err(self.err_field(
                 span,
                 "emission",

@@ -21,6 +21,7 @@ mod mesh;
 mod mtl;
 pub mod obj;
 mod sdf;
+mod texture_file;
 mod warnings;
 
 pub use assets::AssetPath;
@@ -209,10 +210,11 @@ impl Scene {
         self.materials.get(index as usize).unwrap_or(&Material::BLACK)
     }
 
-    /// The material at a hit.
+    /// The material at a hit, a texture looked up at its texture
+    /// coordinates ([`Material::at_uv`]).
     #[inline]
-    pub fn material_at(&self, surface: &SurfaceHit) -> &Material {
-        self.material(surface.material)
+    pub fn material_at(&self, surface: &SurfaceHit) -> Material {
+        self.material(surface.material).at_uv(surface.uv)
     }
 
     pub fn lights(&self) -> &[Light] {
