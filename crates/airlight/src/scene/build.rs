@@ -62,6 +62,29 @@ pub fn build(desc: &SceneDesc, text: &str, assets: &AssetPath) -> Result<Scene, 
     Ok(scene)
 }
 
+/// A medium from the keys of a scene file's `[medium]` table written as
+/// one line, `key = value` pairs separated by commas (`sigma_s = 0.05,
+/// sigma_a = 0.01, g = 0.3`; colours as `[r, g, b]`; `type = "height"`),
+/// checked by the same rules as the table. For command lines, which give
+/// a medium without a scene file; a message without a line number.
+pub fn medium_from_options(options: &str) -> Result<Medium, String> {
+    let text = format!("medium = {{ {options} }}");
+    let strip = |e: SceneError| e.message;
+    let desc: SceneDesc = parse(&text).map_err(strip)?;
+    let Some(medium) = &desc.medium else { return Err("no medium".into()) };
+    let assets = AssetPath::new(None, &[]);
+    let checker = Checker {
+        text: &text,
+        assets: &assets,
+        document: Default::default(),
+        files: RefCell::default(),
+        mesh_bytes: Cell::new(0),
+        notes: RefCell::default(),
+        textures: RefCell::default(),
+    };
+    checker.medium(medium).map_err(strip)
+}
+
 pub(super) struct Checker<'a> {
     text: &'a str,
     pub(super) assets: &'a AssetPath,

@@ -25,7 +25,7 @@ mod texture_file;
 mod warnings;
 
 pub use assets::AssetPath;
-pub use build::{build, parse};
+pub use build::{build, medium_from_options, parse};
 pub use desc::SceneDesc;
 pub use error::{SceneError, line_col};
 pub use lights::LightCulling;
@@ -229,6 +229,12 @@ impl Scene {
     /// The participating medium, if there is one that absorbs or scatters.
     pub fn medium(&self) -> Option<&Medium> {
         self.medium.as_ref()
+    }
+
+    /// Replaces the medium (None, or a vacuum: no medium). Integrators
+    /// built for the scene before must be built again.
+    pub fn set_medium(&mut self, medium: Option<Medium>) {
+        self.medium = medium.filter(|m| !m.is_vacuum());
     }
 
     pub fn geometry(&self) -> &Geometry {
