@@ -109,7 +109,8 @@ pub struct RenderArgs {
     threads: Option<u32>,
     /// Also write, as layers of each .exr output, what the camera's first
     /// hits are: a comma-separated list of albedo, normal, depth and
-    /// variance (variance implies --progressive)
+    /// variance (variance implies --progressive); and inscatter, the
+    /// medium's light alone (raymarch, analytic, stochastic)
     #[arg(long, value_name = "LIST", value_parser = crate::aovs::parse_list)]
     aov: Option<crate::aovs::AovList>,
     /// No progress bar or summary.
@@ -208,7 +209,7 @@ pub fn render(args: RenderArgs) -> Result<(), String> {
     let aovs = args.aov.clone().map(|list| list.0).unwrap_or_default();
     let progressive =
         args.progressive || args.target_error.is_some() || args.variance.is_some() || aovs.contains(&Aov::Variance);
-    crate::aovs::check(&aovs, &outputs, plan.partial)?;
+    crate::aovs::check(&aovs, &outputs, plan.partial, desc.kind)?;
     let (files, variance) = (scene.files(), args.variance.as_deref());
     crate::outputs::check_render(args.scene.as_deref(), files, &outputs, variance, args.frames)?;
     crate::preflight::render_memory(&scene, progressive)?;
@@ -347,7 +348,7 @@ fn configure(args: &RenderArgs) -> Result<SceneFile, String> {
         file.scene.set_attenuation_model(model).map_err(|e| format!("--attenuation: {e}"))?;
     }
     if let Some(MediumOption(medium)) = &args.medium {
-        file.scene.set_medium(medium.clone());
+        file.scene.set_medium(*medium);
     }
     Ok(file)
 }
