@@ -12,6 +12,7 @@ pub mod assets;
 mod build;
 mod build_camera;
 mod build_lights;
+mod build_materials;
 pub mod desc;
 mod error;
 mod gltf;
@@ -25,7 +26,8 @@ mod texture_file;
 mod warnings;
 
 pub use assets::AssetPath;
-pub use build::{build, medium_from_options, parse};
+pub use build::{build, parse};
+pub use build_materials::medium_from_options;
 pub use desc::SceneDesc;
 pub use error::{SceneError, line_col};
 pub use lights::LightCulling;
