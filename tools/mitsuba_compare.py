@@ -1,18 +1,32 @@
 #!/usr/bin/env python3
 """Render Airlight scenes with Mitsuba 3 and with Airlight, and compare.
 
-    pip install mitsuba            # once; the scalar_rgb variant runs on any CPU
-    python3 tools/mitsuba_compare.py [--spp N] [--variant scalar_rgb] SCENE.toml...
+    pip install mitsuba==3.9.1 numpy    # once
+    apt-get install libllvm19           # for llvm_ad_rgb on Debian 12
+    DRJIT_LIBLLVM_PATH=/usr/lib/x86_64-linux-gnu/libLLVM-19.so \
+        python3 tools/mitsuba_compare.py [--spp N] [--variant V]... SCENE.toml...
 
 For each scene it translates the TOML file into a Mitsuba 3 scene (the
 subset of the schema the comparison scenes use: perspective camera, quad,
 sphere, box and plane objects, diffuse materials, point, spot, quad and
-sphere lights, a homogeneous medium filling space), renders it with
+sphere lights, a homogeneous medium filling space or a density grid with
+a grey extinction), renders it with
 Mitsuba's `volpath` (or `path` in vacuum), renders it with `airlight render
 --integrator path` at the same size and sample count, and prints
 `airlight compare` of the two, plus the noise floors: each renderer
 against itself with another seed, from which each image's own error and
 the time each renderer needs for the same error follow (error ∝ 1/√time).
+A scene whose `[render] integrator` is "direct" runs Mitsuba's `direct`
+(one emitter sample, no BSDF sample) and Airlight's `direct` instead.
+
+Variants: by default `llvm_ad_rgb` (Mitsuba's fastest CPU variant:
+vectorised wavefronts, JIT-compiled by LLVM; Debian 12's LLVM 15 crashes it,
+LLVM 19 works) and `scalar_rgb`, each timed in the same run. In the llvm
+variants `mi.render` only records the computation: the time is taken
+around `mi.render`, `dr.eval` and `dr.sync_thread`, after a first render
+with another seed that compiles the kernels. Airlight's time is the one
+`airlight render` reports (after the scene is loaded and its BVH built, as
+Mitsuba's excludes `load_dict`).
 
 Conventions matched (docs/scene-format.md): intensities in W/sr, radiance for
 area lights; a pixel is the box-filtered mean; Mitsuba's max_depth counts
@@ -89,8 +103,9 @@ def translate(path, spp):
     scene = {"type": "scene"}
     ext = {}
     if medium:
-        if medium.get("type", "homogeneous") != "homogeneous":
-            raise SystemExit(f"{path}: only homogeneous media translate to Mitsuba here")
+        kind = medium.get("type", "homogeneous")
+        if kind not in ("homogeneous", "grid"):
+            raise SystemExit(f"{path}: only homogeneous and grid media translate to Mitsuba here")
         sa, ss = colour(medium.get("sigma_a")), colour(medium.get("sigma_s"))
         st = [a + b for a, b in zip(sa, ss)]
         scene["fog"] = {
@@ -100,8 +115,21 @@ def translate(path, spp):
             "albedo": {"type": "rgb", "value": [b / t if t > 0 else 0.0 for b, t in zip(ss, st)]},
             "phase": {"type": "hg", "g": float(medium.get("g", 0.0))},
         }
+        if kind == "grid":
+            # Mitsuba's heterogeneous medium: one extinction (the grid times
+            # `scale`), so σt must be grey; the .vol's box placed by the
+            # medium's transform, as Airlight places it.
+            if max(st) - min(st) > 1e-6 * max(st):
+                raise SystemExit(f"{path}: a grid compares with Mitsuba only with a grey sigma_a + sigma_s")
+            grid = {"type": "gridvolume", "filename": os.path.join(os.path.dirname(path), medium["file"]),
+                    "use_grid_bbox": True, "to_world": object_transform(medium)}
+            scene["fog"].update({"type": "heterogeneous", "sigma_t": grid,
+                                 "scale": st[0] * float(medium.get("density_scale", 1.0))})
         ext = {"exterior": {"type": "ref", "id": "fog"}, "interior": {"type": "ref", "id": "fog"}}
-    scene["integrator"] = {"type": "volpath" if medium else "path", "max_depth": max_depth + 1}
+    if r.get("integrator") == "direct":
+        scene["integrator"] = {"type": "direct", "emitter_samples": 1, "bsdf_samples": 0}
+    else:
+        scene["integrator"] = {"type": "volpath" if medium else "path", "max_depth": max_depth + 1}
     sensor = {
         "type": "perspective",
         "fov": float(cam.get("fov", 40.0)),
@@ -144,6 +172,10 @@ def translate(path, spp):
             size = 1000.0
             corner = [o["point"][k] - size * (a[k] + b[k]) for k in range(3)]
             shape = {"type": "rectangle", "to_world": rectangle(corner, [2 * size * x for x in a], [2 * size * x for x in b])}
+        elif t == "mesh":
+            # Flat-shaded, as Airlight shades meshes with the winding's normal.
+            filename = os.path.join(os.path.dirname(os.path.abspath(path)), o["file"])
+            shape = {"type": "obj", "filename": filename, "face_normals": True}
         else:
             raise SystemExit(f"{path}: object type {t} does not translate")
         if t in ("sphere",) and any(k in o for k in ("translate", "rotate", "scale")):
@@ -194,7 +226,26 @@ def airlight(*args):
     out = subprocess.run([binary, *args], capture_output=True, text=True)
     if out.returncode != 0:
         raise SystemExit(f"airlight {' '.join(args)} failed: {out.stderr.strip()}")
-    return out.stdout
+    return out.stdout, out.stderr
+
+
+def render_seconds(stderr):
+    """The render time `airlight render` reports ("rendered ... in T s")."""
+    for line in stderr.splitlines():
+        if line.startswith("rendered ") and " in " in line:
+            return float(line.split(" in ")[1].split()[0])
+    raise SystemExit(f"airlight render reported no time: {stderr.strip()}")
+
+
+def time_mitsuba(mi, dr, scene, spp, seed):
+    """Seconds for one render, waiting for the result: in the llvm variants
+    `mi.render` returns at once and the work runs at `dr.eval`."""
+    import time
+    start = time.perf_counter()
+    image = mi.render(scene, spp=spp, seed=seed)
+    dr.eval(image)
+    dr.sync_thread()
+    return time.perf_counter() - start, image
 
 
 def fmt(v):
@@ -205,49 +256,53 @@ def main():
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("scenes", nargs="+")
     p.add_argument("--spp", type=int, default=256)
-    p.add_argument("--variant", default="scalar_rgb")
+    p.add_argument("--variant", action="append", help="Mitsuba variant, may repeat (default: llvm_ad_rgb and scalar_rgb)")
     p.add_argument("--out", default=os.path.join(tempfile.gettempdir(), "airlight-mitsuba"))
     args = p.parse_args()
+    import drjit as dr
     import mitsuba as mi
-    import time
-    mi.set_variant(args.variant)
+    variants = args.variant or ["llvm_ad_rgb", "scalar_rgb"]
     os.makedirs(args.out, exist_ok=True)
+    field = lambda text, key: float([l for l in text.splitlines() if l.startswith(key + ":")][0].split()[1])
+    means = lambda text, key: [float(x) for x in [l for l in text.splitlines() if l.startswith(key + ":")][0].split()[1:]]
     for path in args.scenes:
         name = os.path.splitext(os.path.basename(path))[0]
-        scene_dict, _, _ = translate(path, args.spp)
-        scene = mi.load_dict(scene_dict)
-        start = time.time()
-        image = mi.render(scene, spp=args.spp)
-        mitsuba_seconds = time.time() - start
-        ref = os.path.join(args.out, f"{name}.mitsuba.exr")
-        mi.util.write_bitmap(ref, image, write_async=False)
-        # Mitsuba again with another seed: its own noise, for equal-error times.
-        ref_other = os.path.join(args.out, f"{name}.mitsuba-seed1.exr")
-        mi.util.write_bitmap(ref_other, mi.render(scene, spp=args.spp, seed=1), write_async=False)
+        with open(path, "rb") as f:
+            integrator = tomllib.load(f).get("render", {}).get("integrator")
+        integrator = "direct" if integrator == "direct" else "path"
         ours = os.path.join(args.out, f"{name}.airlight.exr")
         other = os.path.join(args.out, f"{name}.airlight-seed1.exr")
-        start = time.time()
-        airlight("render", path, "--integrator", "path", "--spp", str(args.spp), "-o", ours, "--quiet")
-        airlight_seconds = time.time() - start
-        airlight("render", path, "--integrator", "path", "--spp", str(args.spp), "--seed", "1", "-o", other, "--quiet")
-        vs = airlight("compare", ours, ref, "--map", os.path.join(args.out, f"{name}.error.png"))
-        noise = airlight("compare", ours, other)
-        mitsuba_noise = airlight("compare", ref, ref_other)
-        field = lambda text, key: float([l for l in text.splitlines() if l.startswith(key + ":")][0].split()[1])
-        print(f"{name}: {args.spp} spp; Mitsuba {args.variant} {mitsuba_seconds:.1f} s, Airlight {airlight_seconds:.1f} s")
-        print(f"  airlight vs mitsuba: rel_rmse {field(vs, 'rel_rmse'):.4f}  rmse {field(vs, 'rmse'):.5f}  mae {field(vs, 'mae'):.5f}")
-        print(f"  airlight vs airlight (seed 1): rel_rmse {field(noise, 'rel_rmse'):.4f}  rmse {field(noise, 'rmse'):.5f}  mae {field(noise, 'mae'):.5f}")
-        print(f"  mitsuba vs mitsuba (seed 1): rel_rmse {field(mitsuba_noise, 'rel_rmse'):.4f}")
-        # Each image's own error is the seed-to-seed difference over √2; error
-        # falls as 1/√time, so equal error costs time · error².
-        e_a, e_m = field(noise, "rel_rmse") / math.sqrt(2), field(mitsuba_noise, "rel_rmse") / math.sqrt(2)
-        if e_a > 0:
-            speedup = (mitsuba_seconds * e_m**2) / (airlight_seconds * e_a**2)
-            print(f"  own error: airlight {e_a:.4f}, mitsuba {e_m:.4f}; Airlight faster at equal error by {speedup:.1f}x")
-        means = lambda key: [float(x) for x in [l for l in vs.splitlines() if l.startswith(key + ":")][0].split()[1:]]
-        ma, mm = means("mean_a"), means("mean_b")
-        print(f"  image means: airlight {fmt(ma)}  mitsuba {fmt(mm)}  ratio {fmt([a / b if b else float('nan') for a, b in zip(ma, mm)])}")
-        sys.stdout.flush()
+        common = ["render", path, "--integrator", integrator, "--spp", str(args.spp)]
+        airlight_seconds = render_seconds(airlight(*common, "-o", ours)[1])
+        airlight(*common, "--seed", "1", "-o", other, "--quiet")
+        noise = airlight("compare", ours, other)[0]
+        e_a = field(noise, "rel_rmse") / math.sqrt(2)
+        print(f"{name}: {args.spp} spp, {integrator}; Airlight {airlight_seconds:.3f} s, own error {e_a:.4f}")
+        for variant in variants:
+            mi.set_variant(variant)
+            scene_dict, _, _ = translate(path, args.spp)
+            scene = mi.load_dict(scene_dict)
+            time_mitsuba(mi, dr, scene, args.spp, 7)  # compiles the llvm kernels
+            mitsuba_seconds, image = time_mitsuba(mi, dr, scene, args.spp, 0)
+            ref = os.path.join(args.out, f"{name}.{variant}.exr")
+            mi.util.write_bitmap(ref, image, write_async=False)
+            # Mitsuba again with another seed: its own noise, for equal-error times.
+            ref_other = os.path.join(args.out, f"{name}.{variant}-seed1.exr")
+            mi.util.write_bitmap(ref_other, time_mitsuba(mi, dr, scene, args.spp, 1)[1], write_async=False)
+            vs = airlight("compare", ours, ref, "--map", os.path.join(args.out, f"{name}.{variant}.error.png"))[0]
+            mitsuba_noise = airlight("compare", ref, ref_other)[0]
+            # Each image's own error is the seed-to-seed difference over √2;
+            # error falls as 1/√time, so equal error costs time · error².
+            e_m = field(mitsuba_noise, "rel_rmse") / math.sqrt(2)
+            print(f"  Mitsuba {variant}: {mitsuba_seconds:.3f} s, own error {e_m:.4f}; per sample Airlight is {mitsuba_seconds / airlight_seconds:.2f}x as fast", end="")
+            if e_a > 0:
+                speedup = (mitsuba_seconds * e_m**2) / (airlight_seconds * e_a**2)
+                print(f", at equal error {speedup:.2f}x", end="")
+            print()
+            print(f"    airlight vs mitsuba: rel_rmse {field(vs, 'rel_rmse'):.4f}  rmse {field(vs, 'rmse'):.5f}  mae {field(vs, 'mae'):.5f}")
+            ma, mm = means(vs, "mean_a"), means(vs, "mean_b")
+            print(f"    image means: airlight {fmt(ma)}  mitsuba {fmt(mm)}  ratio {fmt([a / b if b else float('nan') for a, b in zip(ma, mm)])}")
+            sys.stdout.flush()
 
 
 if __name__ == "__main__":

@@ -348,7 +348,7 @@ fn configure(args: &RenderArgs) -> Result<SceneFile, String> {
         file.scene.set_attenuation_model(model).map_err(|e| format!("--attenuation: {e}"))?;
     }
     if let Some(MediumOption(medium)) = &args.medium {
-        file.scene.set_medium(*medium);
+        file.scene.set_medium(medium.clone());
     }
     Ok(file)
 }

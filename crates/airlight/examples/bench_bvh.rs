@@ -1,13 +1,16 @@
 //! Primary-ray throughput on a mesh of over a million triangles.
 //!
-//! `cargo run --release --example bench_bvh [-- SUBDIVISIONS]`
+//! `cargo run --release --example bench_bvh [-- SUBDIVISIONS] [--no-reference]`
 //!
 //! Builds a displaced sphere (a UV sphere with SUBDIVISIONS² quads, default
 //! 750² → 1.12 M triangles, radius modulated by a sum of sines), frames it
 //! with a camera and traces one coherent primary ray per pixel of a
-//! 1024×1024 image, tile by tile, on one thread and then on all threads.
+//! 1024×1024 image, tile by tile, then one shadow ray from each hit toward a
+//! point light, each on one thread and then on all threads. Then the same
+//! rays through obvhs's compressed 8-wide BVH and its traversal (what
+//! Airlight used before), unless `--no-reference` is given.
 
-use airlight::geometry::{GeometryBuilder, Ray, Shape};
+use airlight::geometry::{GeometryBuilder, Ray, Shape, intersect_triangle, offset_origin};
 use airlight::prelude::*;
 use glam::Vec2;
 use rayon::prelude::*;
@@ -67,24 +70,133 @@ fn main() {
             }
         }
     }
-    let trace = |ray: &Ray| geometry.intersect(ray, f32::INFINITY).is_some() as u64;
-    // Warm up, then time one thread.
-    let hits: u64 = rays.iter().take(100_000).map(trace).sum();
-    let t = Instant::now();
-    let hits1: u64 = rays.iter().map(trace).sum();
-    let one = t.elapsed().as_secs_f64();
-    let t = Instant::now();
-    let hits2: u64 = rays.par_chunks(256).map(|c| c.iter().map(trace).sum::<u64>()).sum();
-    let all = t.elapsed().as_secs_f64();
-    assert_eq!(hits1, hits2);
-    let _ = hits;
     let threads = rayon::current_num_threads();
-    println!(
-        "{} primary rays, {:.1}% hit the mesh\n1 thread: {:.2} M rays/s\n{threads} threads: {:.2} M rays/s ({:.2} M rays/s per core)",
-        rays.len(),
-        100.0 * hits1 as f64 / rays.len() as f64,
-        rays.len() as f64 / one / 1e6,
-        rays.len() as f64 / all / 1e6,
-        rays.len() as f64 / all / 1e6 / threads as f64
+    let hit_points: Vec<Option<(Vec3, Vec3)>> = rays
+        .iter()
+        .map(|ray| geometry.intersect(ray, f32::INFINITY).map(|hit| (ray.at(hit.t), geometry.surface(ray, hit).n)))
+        .collect();
+    let hits = hit_points.iter().filter(|h| h.is_some()).count();
+    println!("{} primary rays, {:.1}% hit the mesh", rays.len(), 100.0 * hits as f64 / rays.len() as f64);
+    // One shadow ray from each hit toward a point light, as direct lighting
+    // issues them.
+    let light = vec3(2.0, 3.0, -3.0);
+    let shadow: Vec<(Vec3, Vec3, f32)> = hit_points
+        .iter()
+        .flatten()
+        .map(|&(p, n)| {
+            let o = offset_origin(p, n, light - p);
+            let to = light - o;
+            (o, to.normalize(), to.length())
+        })
+        .collect();
+
+    let primary = |ray: &Ray| geometry.intersect(ray, f32::INFINITY).is_some() as u64;
+    let occluded = |&(o, d, t): &(Vec3, Vec3, f32)| geometry.occluded(o, d, t) as u64;
+    let p = time(&rays, primary);
+    let s = time(&shadow, occluded);
+    report("Airlight BVH4", &p, &s, threads);
+    println!("  {:.1}% of shadow rays blocked", 100.0 * s.sum as f64 / shadow.len() as f64);
+
+    // The traversal Airlight used before: obvhs's compressed 8-wide BVH and
+    // its own traversal over the same triangles, for a side-by-side figure.
+    if std::env::args().any(|a| a == "--no-reference") {
+        return;
+    }
+    let tris: Vec<obvhs::triangle::Triangle> = triangles
+        .iter()
+        .map(|t| {
+            let Shape::Mesh { positions, .. } = &mesh else { unreachable!() };
+            let [v0, v1, v2] = t.map(|i| positions[i as usize].into());
+            obvhs::triangle::Triangle { v0, v1, v2 }
+        })
+        .collect();
+    let t = Instant::now();
+    let cwbvh = obvhs::cwbvh::builder::build_cwbvh_from_tris(
+        &tris,
+        obvhs::BvhBuildParams::medium_build(),
+        &mut std::time::Duration::default(),
     );
+    let tris: Vec<[Vec3; 3]> = cwbvh
+        .primitive_indices
+        .iter()
+        .map(|&i| {
+            let t = &tris[i as usize];
+            let v0 = Vec3::from(t.v0);
+            [v0, Vec3::from(t.v1) - v0, Vec3::from(t.v2) - v0]
+        })
+        .collect();
+    println!("reference CWBVH built in {:.2} s", t.elapsed().as_secs_f64());
+    let bvh_ray = |o: Vec3, d: Vec3, tmax: f32| {
+        obvhs::ray::Ray::new(o.into(), glam::Vec3A::from(d) + glam::Vec3A::ZERO, 0.0, tmax)
+    };
+    let primary_ref = |ray: &Ray| {
+        let mut hit = obvhs::ray::RayHit::none();
+        cwbvh.ray_traverse(bvh_ray(ray.origin, ray.dir, f32::INFINITY), &mut hit, |r, id| {
+            let [v0, e1, e2] = tris[id];
+            intersect_triangle(v0, e1, e2, ray.origin, ray.dir, 0.0, r.tmax)
+        }) as u64
+    };
+    let occluded_ref = |&(o, d, tmax): &(Vec3, Vec3, f32)| {
+        !cwbvh.ray_traverse_miss(bvh_ray(o, d, tmax), |r, id| {
+            let [v0, e1, e2] = tris[id];
+            intersect_triangle(v0, e1, e2, o, d, 0.0, r.tmax)
+        }) as u64
+    };
+    let pr = time(&rays, primary_ref);
+    let sr = time(&shadow, occluded_ref);
+    assert_eq!((pr.sum, sr.sum), (p.sum, s.sum), "the two traversals disagree on hits");
+    report("obvhs CWBVH (before)", &pr, &sr, threads);
+    println!(
+        "speed-up per CPU second, 1 thread: primary {:.2}×, shadow {:.2}×",
+        pr.one_cpu / p.one_cpu,
+        sr.one_cpu / s.one_cpu
+    );
+}
+
+/// The CPU time this thread or process has used: rates per CPU second hold
+/// while other programs share the cores, where wall-clock rates do not.
+fn cpu_seconds(clock: libc::clockid_t) -> f64 {
+    let mut ts = libc::timespec { tv_sec: 0, tv_nsec: 0 };
+    // SAFETY: clock_gettime writes one timespec to a valid pointer.
+    unsafe { libc::clock_gettime(clock, &mut ts) };
+    ts.tv_sec as f64 + ts.tv_nsec as f64 * 1e-9
+}
+
+/// A timed run: wall seconds on one thread, that thread's CPU seconds, wall
+/// seconds on all threads, the process's CPU seconds for it, the summed
+/// result and the number of rays.
+struct Timing {
+    one: f64,
+    one_cpu: f64,
+    all: f64,
+    all_cpu: f64,
+    sum: u64,
+    n: usize,
+}
+
+fn time<T: Sync>(items: &[T], f: impl Fn(&T) -> u64 + Sync) -> Timing {
+    let warm: u64 = items.iter().take(100_000).map(&f).sum();
+    std::hint::black_box(warm);
+    let (t, c) = (Instant::now(), cpu_seconds(libc::CLOCK_THREAD_CPUTIME_ID));
+    let sum: u64 = items.iter().map(&f).sum();
+    let (one, one_cpu) = (t.elapsed().as_secs_f64(), cpu_seconds(libc::CLOCK_THREAD_CPUTIME_ID) - c);
+    let (t, c) = (Instant::now(), cpu_seconds(libc::CLOCK_PROCESS_CPUTIME_ID));
+    let all_sum: u64 = items.par_chunks(256).map(|c| c.iter().map(&f).sum::<u64>()).sum();
+    let (all, all_cpu) = (t.elapsed().as_secs_f64(), cpu_seconds(libc::CLOCK_PROCESS_CPUTIME_ID) - c);
+    assert_eq!(sum, all_sum);
+    Timing { one, one_cpu, all, all_cpu, sum, n: items.len() }
+}
+
+fn report(name: &str, primary: &Timing, shadow: &Timing, threads: usize) {
+    println!("{name}:");
+    for (kind, t) in [("primary", primary), ("shadow", shadow)] {
+        let m = t.n as f64 / 1e6;
+        println!(
+            "  {kind:7} 1 thread: {:6.2} M rays/s ({:6.2} per CPU s)   {threads} threads: {:6.2} M rays/s ({:6.2} per CPU s)",
+            m / t.one,
+            m / t.one_cpu,
+            m / t.all,
+            m / t.all_cpu
+        );
+    }
 }

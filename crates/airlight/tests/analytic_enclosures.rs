@@ -52,6 +52,13 @@ fn base(eye: Vec3, target: Vec3, g: f32) -> SceneBuilder {
 /// documentation): relative RMSE at most 3 × |march 2048 − march 4096| plus
 /// 1e-5 (the f32 image).
 fn agrees_with_march(name: &str, scene: &Scene) {
+    agrees_with_march_within(name, scene, 1e-5);
+}
+
+/// As [`agrees_with_march`], with `allowance` in place of 1e-5: the error
+/// of a rule over a light's points, where the closed form is summed over
+/// them.
+fn agrees_with_march_within(name: &str, scene: &Scene, allowance: f64) {
     let options = AnalyticOptions { shadows: true, light_steps: 16, quadrature: LightQuadrature::Gauss };
     let analytic = Analytic::new(scene, options).unwrap_or_else(|e| panic!("{name}: {e}"));
     let march =
@@ -65,7 +72,7 @@ fn agrees_with_march(name: &str, scene: &Scene) {
         an.mean().x,
         reference.mean().x,
     );
-    assert!(err <= 3.0 * march_err + 1e-5, "{name}: rel_rmse {err:e}, the march's own error {march_err:e}");
+    assert!(err <= 3.0 * march_err + allowance, "{name}: rel_rmse {err:e}, the march's own error {march_err:e}");
     assert!(reference.mean().x > 0.0);
 }
 
@@ -195,9 +202,29 @@ fn area_lights_in_a_box_room() {
 }
 
 #[test]
+fn a_sphere_light_near_a_ball() {
+    // Near a surface that casts penumbrae, a sphere light is a sum of
+    // points on its surface (light_steps/2 = 8 per dimension, up to two
+    // splits), whose rule errs by 0.7e-3 to 2.1e-3 in relative RMSE here.
+    // The point at the centre does better in these views (0.8e-4 to
+    // 4.1e-4: their penumbrae are a small part of the image), but errs by
+    // tens of percent where penumbrae fill a view (tests/differential.rs,
+    // seeds 606, 2402, 3374, 3912).
+    let rule = 3e-3;
+    let lights = [
+        ("sphere light 0.2 above a ball", Light::sphere(vec3(0.6, 1.35, 0.4), 0.15, Rgb::splat(20.0))),
+        ("sphere light 0.05 beside a ball", Light::sphere(vec3(-0.25, 0.6, 0.4), 0.3, Rgb::splat(20.0))),
+        ("sphere light 0.1 beside a ball", Light::sphere(vec3(-0.1, 0.9, 0.2), 0.15, Rgb::splat(20.0))),
+    ];
+    for (name, light) in lights {
+        agrees_with_march_within(name, &box_room(light), rule);
+    }
+}
+
+#[test]
 fn a_sphere_light_that_a_surface_cuts_through_is_refused() {
-    // Shadowed as a point at its centre, a bulb half sunk into the ceiling
-    // (centre above it) would light nothing below: refused, by name.
+    // The rule over its whole surface would put too few points on the
+    // part beyond the cut: refused, by name.
     let options = AnalyticOptions { shadows: true, light_steps: 16, quadrature: LightQuadrature::Gauss };
     let bulb = |y: f32| Light::sphere(vec3(0.0, y, 0.0), 0.2, Rgb::splat(20.0));
     let err = Analytic::new(&box_room(bulb(2.55)), options).err().unwrap();

@@ -37,8 +37,11 @@ fn white_furnace_gives_the_wall_radiance_everywhere() {
         Medium::homogeneous(Rgb::ZERO, Rgb::splat(1.5), 0.7),
         Medium::height(Rgb::ZERO, Rgb::new(0.8, 0.4, 1.2), -0.3, -1.0, 0.9),
     ] {
-        let image =
-            render(&furnace(medium), &PathTracer::new(PathOptions { max_depth: 10_000 }), &RenderObserver::none());
+        let image = render(
+            &furnace(medium.clone()),
+            &PathTracer::new(PathOptions { max_depth: 10_000 }),
+            &RenderObserver::none(),
+        );
         // The image mean against 1, within four standard errors (measured
         // from the spread of the pixels, which are independent).
         let mean = image.mean();
@@ -147,12 +150,12 @@ fn single_scattering_path_tracing_agrees_with_marching() {
             Medium::homogeneous(Rgb::new(0.02, 0.03, 0.04), Rgb::new(0.10, 0.07, 0.05), 0.3),
             PathTracer::new(PathOptions { max_depth: 1 }),
         ),
-        (height, PathTracer::new(PathOptions { max_depth: 1 })),
+        (height.clone(), PathTracer::new(PathOptions { max_depth: 1 })),
         (height, tracking),
     ] {
-        let path = render(&fog_scene(medium, 32_768, 0), &tracer, &RenderObserver::none());
+        let path = render(&fog_scene(medium.clone(), 32_768, 0), &tracer, &RenderObserver::none());
         let marched = render(
-            &fog_scene(medium, 16, 0),
+            &fog_scene(medium.clone(), 16, 0),
             &Raymarch::new(RaymarchOptions { steps: 4096, jitter: true }),
             &RenderObserver::none(),
         );
@@ -175,7 +178,7 @@ fn equiangular_light_sampling_lowers_the_error_near_lights() {
     // has finite variance near the light.
     let medium = Medium::homogeneous(Rgb::new(0.02, 0.03, 0.04), Rgb::new(0.10, 0.07, 0.05), 0.3);
     let in_view = |spp| {
-        let mut scene = fog_scene(medium, spp, 5);
+        let mut scene = fog_scene(medium.clone(), spp, 5);
         let mut lights = scene.lights().to_vec();
         lights[0] = Light::point(vec3(0.5, 1.5, 1.0), Rgb::splat(60.0));
         scene.set_lights(&lights);

@@ -112,15 +112,15 @@ fn single_scattering_in_height_fog_agrees_with_marching_within_noise() {
     // The spot's cone crosses few rays over a short stretch: noisier, more
     // samples.
     let cases = [
-        ("point, grey fog", fog, point, above, 4096),
-        ("point, coloured fog, g 0.4", coloured, point, above, 4096),
-        ("point, camera below the base", fog, point, below, 4096),
+        ("point, grey fog", fog.clone(), point, above, 4096),
+        ("point, coloured fog, g 0.4", coloured.clone(), point, above, 4096),
+        ("point, camera below the base", fog.clone(), point, below, 4096),
         ("spot, grey fog", fog, spot, above, 16_384),
         ("spot, coloured fog, camera below the base", coloured, spot, below, 16_384),
     ];
     for (name, medium, light, camera, spp) in cases {
         let marched = render_with(
-            &open_fog(medium, light, camera, 1),
+            &open_fog(medium.clone(), light, camera, 1),
             &Raymarch::new(RaymarchOptions { steps: 2048, jitter: false }),
             &RenderObserver::none(),
         );
@@ -163,7 +163,7 @@ fn extreme_height_fog_gives_finite_images() {
         (Medium::height(Rgb::new(0.0, 1e6, 0.1), Rgb::new(1e6, 0.0, 0.0), 0.9, -1.0, 0.8), camera_at(1.0)),
     ];
     for (medium, camera) in cases {
-        let mut scene = open_fog(medium, Light::point(vec3(0.0, 0.5, 0.0), Rgb::splat(10.0)), camera, 16);
+        let mut scene = open_fog(medium.clone(), Light::point(vec3(0.0, 0.5, 0.0), Rgb::splat(10.0)), camera, 16);
         (scene.settings_mut().width, scene.settings_mut().height) = (8, 8);
         let image = render_with(&scene, &PathTracer::new(PathOptions { max_depth: 8 }), &RenderObserver::none());
         for p in &image.pixels {

@@ -34,7 +34,7 @@ fn far_floor(medium: Option<Medium>) -> Scene {
 fn every_integrator_sees_a_vacuum_and_surfaces_beyond_max_distance_as_direct_does() {
     let vacuum = Medium::homogeneous(Rgb::ZERO, Rgb::ZERO, 0.3);
     for medium in [None, Some(vacuum)] {
-        let scene = far_floor(medium);
+        let scene = far_floor(medium.clone());
         assert!(scene.medium().is_none(), "a vacuum is no medium");
         let direct = render(&scene, IntegratorDesc::default().build(&scene).unwrap().as_ref(), &Default::default());
         assert!(direct.mean().min_element() > 0.01, "the far floor is lit and seen");

@@ -1,12 +1,14 @@
-//! The scene's geometry as flat primitives under one BVH (obvhs's compressed
-//! wide BVH8), plus infinite planes, which no bounding box holds and which are
-//! tested one by one.
+//! The scene's geometry as flat primitives under one BVH (built by obvhs,
+//! flattened into a 4-wide tree traversed with SIMD box tests, see
+//! `bvh4.rs`), plus infinite planes, which no bounding box holds and which
+//! are tested one by one.
 
 use super::Ray;
+use super::bvh4::{self, BoxRay, Bvh4};
 use super::sdf::{Sdf, sphere_trace};
 use super::shape::{Shape, box_normal, intersect_box, intersect_quad, intersect_sphere, intersect_triangle};
 use glam::{Affine3A, Mat3, Vec2, Vec3, Vec3A};
-use obvhs::{Boundable, BvhBuildParams, aabb::Aabb, cwbvh::CwBvh};
+use obvhs::{Boundable, BvhBuildParams, aabb::Aabb};
 use std::time::Duration;
 
 /// One primitive the BVH holds.
@@ -196,15 +198,20 @@ pub struct Geometry {
     records: Vec<Record>,
     planes: Vec<PlaneRecord>,
     unbounded: Vec<UnboundedSdf>,
+    /// Each record's triangle as (v0, e1, e2), zeros for other primitives:
+    /// the compact copy that traversal reads, one 36-byte entry per record.
+    triangles: Vec<[Vec3; 3]>,
     /// None when there are few primitives: testing them all is faster.
-    bvh: Option<CwBvh>,
+    bvh: Option<Bvh4>,
     bounds: Option<(Vec3, Vec3)>,
     /// The texture coordinates of the triangles that have them.
     triangle_uvs: Vec<[Vec2; 3]>,
 }
 
 /// Up to this many primitives are tested one by one, without the BVH.
-const LINEAR_LIMIT: usize = 8;
+const LINEAR_LIMIT: usize = 2;
+/// Up to this many primitives, the BVH's leaves hold one primitive each.
+const SMALL_SCENE: usize = 64;
 
 impl std::fmt::Debug for Geometry {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
@@ -246,12 +253,8 @@ impl GeometryBuilder {
                     } else {
                         NO_UV
                     };
-                    self.records.push(Record {
-                        prim: Prim::Triangle { v0: a, e1: b - a, e2: c - a },
-                        material,
-                        emitter,
-                        uv,
-                    });
+                    let prim = Prim::Triangle { v0: a, e1: b - a, e2: c - a };
+                    self.records.push(Record { prim, material, emitter, uv });
                 }
             }
             Shape::Transformed { shape, world_from_local } => {
@@ -298,43 +301,43 @@ impl GeometryBuilder {
         let bounds = records.iter().map(|r| r.prim.bounds()).reduce(|a, b| a.union(&b));
         let bounds = bounds.map(|b| (Vec3::from(b.min), Vec3::from(b.max)));
         if records.len() <= LINEAR_LIMIT {
-            return Geometry { records, planes, unbounded, bvh: None, bounds, triangle_uvs };
+            let triangles = triangles_of(&records);
+            return Geometry { records, planes, unbounded, triangles, bvh: None, bounds, triangle_uvs };
         }
-        let mut bvh =
-            obvhs::cwbvh::builder::build_cwbvh(&records, BvhBuildParams::medium_build(), &mut Duration::default());
+        let mut params = BvhBuildParams::medium_build();
+        if records.len() <= SMALL_SCENE {
+            // One primitive per leaf: in a room of a few quads and boxes the
+            // boxes' SIMD test spares most primitive tests, where a leaf of
+            // eight (obvhs's choice for meshes) would test them all.
+            params.max_prims_per_leaf = 1;
+        }
+        let bvh2 = obvhs::bvh2::builder::build_bvh2(&records, params, &mut Duration::default());
+        // Reorder so that the tree's leaf ranges index `records` directly.
+        let records: Vec<Record> = bvh2.primitive_indices.iter().map(|&i| records[i as usize].clone()).collect();
+        let triangles = triangles_of(&records);
+        let mixed = |first: u32, count: u32| {
+            records[first as usize..(first + count) as usize].iter().any(|r| !matches!(r.prim, Prim::Triangle { .. }))
+        };
+        let bvh = Bvh4::from_bvh2(&bvh2, mixed);
         // Many primitives with the same bounds (duplicated objects or faces)
-        // can make the tree deeper than obvhs's fixed traversal stack, which
-        // would then drop nodes without a word: such scenes are searched
-        // linearly instead, slow but right.
-        if depth(&bvh) >= MAX_BVH_DEPTH {
-            return Geometry { records, planes, unbounded, bvh: None, bounds, triangle_uvs };
+        // can make the tree deeper than the traversal's fixed stack: such
+        // scenes are searched linearly instead, slow but right.
+        if bvh.depth() > bvh4::MAX_DEPTH {
+            return Geometry { records, planes, unbounded, triangles, bvh: None, bounds, triangle_uvs };
         }
-        // Reorder so that the BVH's primitive ids index `records` directly.
-        let ordered: Vec<Record> = bvh.primitive_indices.iter().map(|&i| records[i as usize].clone()).collect();
-        for (i, index) in bvh.primitive_indices.iter_mut().enumerate() {
-            *index = i as u32;
-        }
-        Geometry { records: ordered, planes, unbounded, bvh: Some(bvh), bounds, triangle_uvs }
+        Geometry { records, planes, unbounded, triangles, bvh: Some(bvh), bounds, triangle_uvs }
     }
 }
 
-/// Deepest BVH traversed: obvhs's traversal stack holds 32 node groups.
-const MAX_BVH_DEPTH: usize = 30;
-
-/// Levels below the root of a compressed wide BVH.
-fn depth(bvh: &CwBvh) -> usize {
-    let mut deepest = 0;
-    let mut stack = vec![(0usize, 0usize)];
-    while let Some((index, level)) = stack.pop() {
-        deepest = deepest.max(level);
-        let Some(node) = bvh.nodes.get(index) else { continue };
-        for child in 0..8 {
-            if node.imask & (1 << child) != 0 {
-                stack.push((node.child_node_index(child) as usize, level + 1));
-            }
-        }
-    }
-    deepest
+/// The (v0, e1, e2) of every triangle record, zeros for other primitives.
+fn triangles_of(records: &[Record]) -> Vec<[Vec3; 3]> {
+    records
+        .iter()
+        .map(|r| match r.prim {
+            Prim::Triangle { v0, e1, e2 } => [v0, e1, e2],
+            _ => [Vec3::ZERO; 3],
+        })
+        .collect()
 }
 
 impl Geometry {
@@ -354,12 +357,21 @@ impl Geometry {
         let mut best = Hit { t: tmax, id: u32::MAX };
         match &self.bvh {
             Some(bvh) => {
-                let r = bvh_ray(ray.origin, ray.dir, tmax);
-                let mut hit = obvhs::ray::RayHit::none();
-                if bvh.ray_traverse(r, &mut hit, |r, id| {
-                    self.records[id].prim.intersect(ray.origin, ray.dir, 0.0, r.tmax)
-                }) {
-                    best = Hit { t: hit.t, id: hit.primitive_id };
+                let (o, d) = (ray.origin, ray.dir);
+                let box_ray = BoxRay::new(o.to_array(), d.to_array());
+                let found = bvh.closest(&box_ray, tmax, |first, count, mixed, mut best_t| {
+                    let mut found = None;
+                    for i in first..first + count {
+                        let t = self.intersect_one(i as usize, mixed, o, d, best_t);
+                        if t < best_t {
+                            best_t = t;
+                            found = Some((t, i));
+                        }
+                    }
+                    found
+                });
+                if let Some((t, id)) = found {
+                    best = Hit { t, id };
                 }
             }
             None => {
@@ -410,10 +422,24 @@ impl Geometry {
         }
         match &self.bvh {
             Some(bvh) => {
-                let r = bvh_ray(origin, dir, tmax);
-                !bvh.ray_traverse_miss(r, |r, id| self.records[id].prim.intersect(origin, dir, 0.0, r.tmax))
+                let box_ray = BoxRay::new(origin.to_array(), dir.to_array());
+                bvh.any(&box_ray, tmax, |first, count, mixed| {
+                    (first..first + count).any(|i| self.intersect_one(i as usize, mixed, origin, dir, tmax) < tmax)
+                })
             }
             None => self.records.iter().any(|rec| rec.prim.intersect(origin, dir, 0.0, tmax) < tmax),
+        }
+    }
+
+    /// Record `i`'s hit distance in (0, tmax), or infinity: from the compact
+    /// triangle copy when its leaf holds only triangles.
+    #[inline(always)]
+    fn intersect_one(&self, i: usize, mixed: bool, o: Vec3, d: Vec3, tmax: f32) -> f32 {
+        if mixed {
+            self.records[i].prim.intersect(o, d, 0.0, tmax)
+        } else {
+            let [v0, e1, e2] = self.triangles[i];
+            intersect_triangle(v0, e1, e2, o, d, 0.0, tmax)
         }
     }
 
@@ -454,9 +480,7 @@ impl Geometry {
             },
         }
     }
-}
 
-impl Geometry {
     /// The texture coordinates at point `p` of a record (see [`SurfaceHit::uv`]).
     fn uv_at(&self, rec: &Record, p: Vec3) -> Option<Vec2> {
         match rec.prim {
@@ -485,14 +509,6 @@ fn barycentric(rel: Vec3, e1: Vec3, e2: Vec3) -> [f32; 2] {
         return [0.0, 0.0];
     }
     [(d22 * r1 - d12 * r2) / det, (d11 * r2 - d12 * r1) / det]
-}
-
-/// The traversal's ray. Adding +0 turns −0 components into +0: obvhs takes
-/// the ray's octant from `d < 0` but its inverse direction from the sign bit,
-/// and a −0 (as in −Vec3::Y) makes the two disagree and the ray miss.
-#[inline]
-fn bvh_ray(origin: Vec3, dir: Vec3, tmax: f32) -> obvhs::ray::Ray {
-    obvhs::ray::Ray::new(origin.into(), Vec3A::from(dir) + Vec3A::ZERO, 0.0, tmax)
 }
 
 #[inline]

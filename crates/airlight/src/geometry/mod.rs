@@ -1,6 +1,7 @@
 //! Rays, shapes and the acceleration structure that finds what a ray hits.
 
 mod accel;
+mod bvh4;
 mod ray;
 pub mod sdf;
 mod shape;

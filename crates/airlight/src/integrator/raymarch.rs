@@ -14,8 +14,9 @@ use glam::DVec3;
 /// The ray-marching integrator.
 ///
 /// The ray's span [0, t_end] (t_end: the hit distance, or max_distance when
-/// nothing is hit or the hit lies beyond it) is cut into `steps` segments of length Δ. Segment i, from
-/// a = iΔ, contributes
+/// nothing is hit or the hit lies beyond it), or the part of it where the
+/// medium can have density (a grid's box), is cut into `steps` segments of
+/// length Δ. Segment i, from a = iΔ past that part's start, contributes
 ///
 ///   T(0, a) · σs(t_i) · S(t_i) · Δ (1 − e^{−τ_i}) / τ_i,
 ///
@@ -83,14 +84,20 @@ pub fn in_scattered(
     if medium.sigma_s == Rgb::ZERO || t_end <= 0.0 {
         return Rgb::ZERO;
     }
-    let dt = t_end / steps as f32;
+    // The steps go where the medium may have density (a grid's box); before
+    // it the medium is vacuum.
+    let Some((start, end)) = medium.extent(ray.origin, ray.dir, 0.0, t_end) else { return Rgb::ZERO };
+    let dt = (end - start) / steps as f32;
     let wo = -ray.dir;
     // Sums in f64: over thousands of steps f32 rounding would otherwise set
     // an error floor near 1e-5 that hides the method's own convergence.
     let mut to_eye = DVec3::ONE;
+    if start > 0.0 {
+        to_eye = medium.transmittance(ray.origin, ray.dir, 0.0, start).as_dvec3();
+    }
     let mut total = DVec3::ZERO;
     for i in 0..steps {
-        let a = i as f32 * dt;
+        let a = start + i as f32 * dt;
         let t = a + offset * dt;
         let p = ray.at(t);
         let tau = medium.optical_depth(ray.origin, ray.dir, a, a + dt);

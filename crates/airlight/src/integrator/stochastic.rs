@@ -122,6 +122,8 @@ impl Stochastic {
         if medium.sigma_s == Rgb::ZERO || length <= 0.0 {
             return total;
         }
+        // Points are drawn where the medium may have density (a grid's box).
+        let Some(span) = medium.extent(ray.origin, ray.dir, 0.0, length) else { return total };
         let wo = -ray.dir;
         for (index, light) in scene.lights().iter().enumerate() {
             let u = if self.stratify {
@@ -130,7 +132,7 @@ impl Stochastic {
                 [sampler.next(), sampler.next(), sampler.next(), sampler.next()]
             };
             let u_light = Vec3::new(u[1], u[2], u[3]);
-            let Some((t, pdf)) = self.distance(ray, length, light.anchor(), u[0]) else { continue };
+            let Some((t, pdf)) = self.distance(ray, span, light.anchor(), u[0]) else { continue };
             let x = ray.at(t);
             let Some(sample) = scene.sample_light(index, x, u_light) else { continue };
             if !scene.unoccluded(x, None, &sample) {
@@ -148,13 +150,14 @@ impl Stochastic {
 }
 
 impl Stochastic {
-    /// A distance t in [0, length] along the ray and its pdf, by the chosen
+    /// A distance t in [start, end] along the ray and its pdf, by the chosen
     /// strategy, given the light's anchor point (uniform without one).
-    fn distance(&self, ray: &Ray, length: f32, anchor: Option<(Vec3, f32)>, u: f32) -> Option<(f32, f32)> {
+    fn distance(&self, ray: &Ray, (start, end): (f32, f32), anchor: Option<(Vec3, f32)>, u: f32) -> Option<(f32, f32)> {
+        let length = end - start;
         let uniform_pdf = 1.0 / length;
         let equiangular = match (self.sampling, anchor) {
-            (Sampling::Uniform, _) | (_, None) => return Some((u * length, uniform_pdf)),
-            (_, Some((y, spread))) => Equiangular::new(ray.origin, ray.dir, y, spread, 0.0, length),
+            (Sampling::Uniform, _) | (_, None) => return Some((start + u * length, uniform_pdf)),
+            (_, Some((y, spread))) => Equiangular::new(ray.origin, ray.dir, y, spread, start, end),
         };
         let (t, pdf) = match self.sampling {
             Sampling::Equiangular => {
@@ -163,7 +166,7 @@ impl Stochastic {
             }
             _ => {
                 // Choose by the first half of u, reuse the rest stretched.
-                let t = if u < 0.5 { 2.0 * u * length } else { equiangular.sample(2.0 * u - 1.0) };
+                let t = if u < 0.5 { start + 2.0 * u * length } else { equiangular.sample(2.0 * u - 1.0) };
                 (t, 0.5 * uniform_pdf + 0.5 * equiangular.pdf(t))
             }
         };

@@ -1,18 +1,27 @@
 //! Participating media: homogeneous fog and exponential height fog, with
-//! transmittance in closed form for both.
+//! transmittance in closed form for both, and a density grid (from a
+//! `.vol` file) and fractal noise fog, whose transmittance is integrated
+//! along the ray and whose free flights are tracked against a majorant.
 
+mod grid;
+pub mod noise;
 mod phase;
 mod profile;
+pub mod vol;
 
+pub use grid::{DensityGrid, MAJORANT_RESOLUTION};
+pub use noise::NoiseFog;
 pub use phase::{henyey_greenstein, isotropic, sample_henyey_greenstein_cos};
 pub use profile::DensityProfile;
 
 use crate::Rgb;
 use glam::Vec3;
+use std::sync::Arc;
 
 /// A medium filling all of space (docs/scene-format.md: `[medium]`). Coefficients are per
-/// unit length, per RGB channel.
-#[derive(Clone, Copy, Debug, PartialEq)]
+/// unit length, per RGB channel, where the density is 1. Cheap to clone:
+/// a grid's voxels are shared.
+#[derive(Clone, Debug, PartialEq)]
 pub struct Medium {
     pub sigma_a: Rgb,
     pub sigma_s: Rgb,
@@ -22,12 +31,17 @@ pub struct Medium {
 }
 
 /// How the coefficients vary in space.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub enum Density {
     /// Constant: the coefficients as given.
     Homogeneous,
     /// Exponential height fog: the coefficients times exp(−falloff·(y − base)).
     Height { base: f32, falloff: f32 },
+    /// The coefficients times a grid's trilinear density; vacuum outside
+    /// its box (grid.rs).
+    Grid(Arc<DensityGrid>),
+    /// The coefficients times fractal noise (noise.rs).
+    Noise(Arc<NoiseFog>),
 }
 
 impl Medium {
@@ -37,6 +51,14 @@ impl Medium {
 
     pub fn height(sigma_a: Rgb, sigma_s: Rgb, g: f32, base: f32, falloff: f32) -> Self {
         Medium { sigma_a, sigma_s, g, density: Density::Height { base, falloff } }
+    }
+
+    pub fn grid(sigma_a: Rgb, sigma_s: Rgb, g: f32, grid: DensityGrid) -> Self {
+        Medium { sigma_a, sigma_s, g, density: Density::Grid(Arc::new(grid)) }
+    }
+
+    pub fn noise(sigma_a: Rgb, sigma_s: Rgb, g: f32, noise: NoiseFog) -> Self {
+        Medium { sigma_a, sigma_s, g, density: Density::Noise(Arc::new(noise)) }
     }
 
     /// Extinction coefficient σt = σa + σs where the density is 1.
@@ -52,24 +74,37 @@ impl Medium {
     /// The density multiplier at `p`.
     #[inline]
     pub fn density_at(&self, p: Vec3) -> f32 {
-        match self.density {
+        match &self.density {
             Density::Homogeneous => 1.0,
             Density::Height { base, falloff } => (-falloff * (p.y - base)).exp(),
+            Density::Grid(grid) => grid.density(p),
+            Density::Noise(noise) => noise.density(p),
         }
     }
 
     /// The density along the line o + t·d (d unit) as ρ(t) = e^{ln ρ0 − a t}
-    /// (profile.rs), for media where it has that closed form: all of them so
-    /// far. A medium without one (a grid, say) would return None and be
-    /// sampled by tracking against a majorant.
+    /// (profile.rs), for media where it has that closed form (homogeneous
+    /// and height fog). A grid has none (None): it is sampled by tracking
+    /// against a majorant.
     pub fn profile(&self, o: Vec3, d: Vec3) -> Option<DensityProfile> {
-        Some(match self.density {
-            Density::Homogeneous => DensityProfile { ln_rho0: 0.0, a: 0.0 },
+        match self.density {
+            Density::Homogeneous => Some(DensityProfile { ln_rho0: 0.0, a: 0.0 }),
             Density::Height { base, falloff } => {
                 let k = falloff as f64;
-                DensityProfile { ln_rho0: -k * (o.y as f64 - base as f64), a: k * d.y as f64 }
+                Some(DensityProfile { ln_rho0: -k * (o.y as f64 - base as f64), a: k * d.y as f64 })
             }
-        })
+            Density::Grid(_) | Density::Noise(_) => None,
+        }
+    }
+
+    /// The part of [t0, t1] of the line o + t·d where the density may be
+    /// non-zero: a grid's box; all of it for media that fill space.
+    pub fn extent(&self, o: Vec3, d: Vec3, t0: f32, t1: f32) -> Option<(f32, f32)> {
+        match &self.density {
+            Density::Grid(grid) => grid.clip(o, d, t0, t1),
+            Density::Noise(noise) => noise.clip(o, d, t0, t1),
+            _ => (t1 > t0).then_some((t0, t1)),
+        }
     }
 
     /// Whether the density along every line has the closed form of
@@ -84,10 +119,13 @@ impl Medium {
     /// and a = falloff·d.y,
     /// ∫ e^{−falloff (y(t) − base)} dt = ρ(t0)·(1 − e^{−a (t1 − t0)})/a,
     /// evaluated in f64 from the segment's denser end ([`DensityProfile::integral`]).
+    /// For a grid, exact for its trilinear density ([`DensityGrid::integral`]);
+    /// for noise, a quadrature ([`NoiseFog::integral`]).
     pub fn density_integral(&self, o: Vec3, d: Vec3, t0: f32, t1: f32) -> f64 {
-        match self.profile(o, d) {
-            Some(profile) => profile.integral(t0 as f64, t1 as f64),
-            None => 0.0,
+        match &self.density {
+            Density::Grid(grid) => grid.integral(o, d, t0, t1),
+            Density::Noise(noise) => noise.integral(o, d, t0, t1),
+            _ => self.profile(o, d).map_or(0.0, |profile| profile.integral(t0 as f64, t1 as f64)),
         }
     }
 

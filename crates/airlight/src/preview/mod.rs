@@ -20,7 +20,8 @@ use crate::scene::Scene;
 mod cache;
 pub use cache::FirstSample;
 
-/// March steps per ray when the medium has no closed form (height fog).
+/// March steps per ray when the medium has no closed form (height fog, a
+/// density grid, noise fog).
 pub const FALLBACK_STEPS: u32 = 16;
 
 /// How the preview lights the medium.

@@ -49,3 +49,27 @@ fn in_a_homogeneous_medium_the_glow_is_analytic_and_adds_light() {
     assert_eq!(plain.pixel(x, y), Rgb::ZERO);
     assert!(foggy.pixel(x, y).min_element() > 0.0, "{}", foggy.pixel(x, y));
 }
+
+#[test]
+fn in_a_density_grid_the_glow_is_marched_and_adds_light() {
+    // No closed form: the preview falls back to its short march (stated in
+    // docs/scene-format.md), which sees the grid's fog where the box is.
+    let grid = crate::medium::DensityGrid::new(
+        [2, 2, 2],
+        vec![0.0, 1.0, 0.5, 0.2, 1.0, 0.0, 0.3, 0.8],
+        vec3(-2.0, 0.0, -2.0),
+        vec3(2.0, 3.0, 2.0),
+        glam::Affine3A::IDENTITY,
+    )
+    .unwrap();
+    let scene = room(Some(Medium::grid(Rgb::ZERO, Rgb::splat(0.2), 0.0, grid)));
+    let foggy_preview = preview(&scene, None);
+    assert_eq!(foggy_preview.glow_name(), "marched glow");
+    let foggy = crate::render::render(&scene, &foggy_preview, &RenderObserver::none());
+    let clear = room(None);
+    let plain = crate::render::render(&clear, &preview(&clear, None), &RenderObserver::none());
+    let (x, y) = (12, 0);
+    assert_eq!(plain.pixel(x, y), Rgb::ZERO);
+    assert!(foggy.pixel(x, y).min_element() > 0.0, "{}", foggy.pixel(x, y));
+    assert!(foggy.pixels.iter().all(|p| p.is_finite()));
+}

@@ -1,10 +1,10 @@
-//! The `[medium]` and `[materials.NAME]` tables of a scene file, checked
-//! and built; and a medium given as one line of the same keys (the
-//! command line's `--medium`).
+//! The `[materials.NAME]` tables of a scene file, checked and built; and a
+//! medium given as one line of `[medium]`'s keys (the command line's
+//! `--medium`), checked as the table is (build_medium.rs).
 
 use super::assets::AssetPath;
 use super::build::{Checker, Result, parse};
-use super::desc::{self, MaterialDesc, MaterialType, MediumDesc, MediumType, Triple};
+use super::desc::{self, MaterialDesc, MaterialType, Triple};
 use super::{SceneDesc, SceneError};
 use crate::Rgb;
 use crate::material::Material;
@@ -37,34 +37,6 @@ pub fn medium_from_options(options: &str) -> Result<Medium, String> {
 }
 
 impl Checker<'_> {
-    pub(super) fn medium(&self, desc: &Spanned<MediumDesc>) -> Result<Medium> {
-        let span = desc.span();
-        let m = desc.get_ref();
-        let sigma_a = self.non_negative3(span.clone(), "medium.sigma_a", m.sigma_a.map_or(Vec3::ZERO, |t| t.0))?;
-        let sigma_s = self.non_negative3(span.clone(), "medium.sigma_s", m.sigma_s.map_or(Vec3::ZERO, |t| t.0))?;
-        let g = m.g.unwrap_or(0.0);
-        if !(g > -1.0 && g < 1.0) {
-            return Err(self.err_field(span, "g", format!("medium.g must lie strictly between -1 and 1, got {g}")));
-        }
-        match m.kind {
-            MediumType::Homogeneous => {
-                if m.base.is_some() || m.falloff.is_some() {
-                    return Err(self.err_field(
-                        span,
-                        if m.base.is_some() { "base" } else { "falloff" },
-                        "base and falloff belong to a `height` medium, not a homogeneous one",
-                    ));
-                }
-                Ok(Medium::homogeneous(sigma_a, sigma_s, g))
-            }
-            MediumType::Height => {
-                let base = self.finite(span.clone(), "medium.base", m.base.unwrap_or(0.0))?;
-                let falloff = self.non_negative(span, "medium.falloff", m.falloff.unwrap_or(0.5))?;
-                Ok(Medium::height(sigma_a, sigma_s, g, base, falloff))
-            }
-        }
-    }
-
     pub(super) fn material(&self, name: &str, desc: &Spanned<MaterialDesc>) -> Result<Material> {
         let span = desc.span();
         let m = desc.get_ref();

@@ -114,6 +114,8 @@ fn perspective() -> CameraType {
 pub enum MediumType {
     Homogeneous,
     Height,
+    Grid,
+    Noise,
 }
 
 #[derive(Debug, Deserialize)]
@@ -126,6 +128,20 @@ pub struct MediumDesc {
     pub g: Option<f32>,
     pub base: Option<f32>,
     pub falloff: Option<f32>,
+    /// Grid: the `.vol` file, its densities' multiplier and its placement.
+    pub file: Option<Spanned<String>>,
+    pub density_scale: Option<f32>,
+    pub translate: Option<Point>,
+    pub rotate: Option<Point>,
+    /// Grid: the transform's scale; noise: the largest features' size.
+    pub scale: Option<Triple>,
+    /// Noise: its octaves, gain, offset, seed and box.
+    pub octaves: Option<Spanned<i64>>,
+    pub gain: Option<f32>,
+    pub offset: Option<f32>,
+    pub seed: Option<Spanned<i64>>,
+    pub min: Option<Point>,
+    pub max: Option<Point>,
 }
 
 fn homogeneous() -> MediumType {

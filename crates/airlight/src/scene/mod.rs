@@ -13,6 +13,7 @@ mod build;
 mod build_camera;
 mod build_lights;
 mod build_materials;
+mod build_medium;
 pub mod desc;
 mod error;
 mod gltf;

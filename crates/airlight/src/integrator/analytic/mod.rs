@@ -40,10 +40,15 @@
 //! times) or quartered (quad, up to 3 times) and the rule applied on each
 //! part: an adaptive composite rule, which leaves far rays with n points.
 //! A sphere light of radiance L and
-//! radius R is, for points outside it, exactly a point light of intensity
-//! πR²L at its centre (a Lambertian sphere's radiant intensity; exact for
-//! isotropic scattering when the extinction along the different paths from
-//! its surface is neglected, O(σt R)).
+//! radius R is, for points outside it, a point light of intensity
+//! πR²L at its centre (a Lambertian sphere's radiant intensity), with a
+//! factor for its near field ([`sphere_factor`]); exact for isotropic
+//! scattering in vacuum, off by O(σt R) and, with g ≠ 0, by the phase taken
+//! toward the centre. Where an occluder that can cast a penumbra comes
+//! within [`NEAR_RADII`] radii of it (the point's hard shadows would
+//! misplace the wide penumbrae there), it is a sum of Lambertian points on
+//! its surface, like a quad light's (`light_steps`/2 points per dimension
+//! in z and φ, split up to twice where a ray passes close).
 //!
 //! Shadows (`shadows = true`): each occluder's shadow along the ray is
 //! found exactly, with no shadow rays, for any arrangement of lights,
@@ -61,9 +66,7 @@
 //! lights with a real-time attenuation model other than `physical` (the
 //! closed form integrates 1/r²), and when `shadows` is on SDF objects (they
 //! have no exact shadow boundaries; without shadows they only end rays) and
-//! sphere lights that a surface cuts through (shadowed as a point at their
-//! centre, they would light nothing on the far side of a surface that their
-//! ball reaches through; see clearance.rs).
+//! sphere lights that a surface cuts through (see clearance.rs).
 
 mod blockers;
 mod boundaries;
@@ -83,7 +86,7 @@ pub use boundaries::{
 };
 pub use closed_form::{Glow, P_FLOOR, glow_extinction, glow_vacuum, glow_vacuum_f32, seed_coordinates, sun_f};
 pub use expint::{Complex, scaled_e1};
-pub use lights::sphere_factor;
+pub use lights::{NEAR_RADII, sphere_factor};
 pub use quadrature::Rule;
 pub use table::{TABLE_ERROR, im_s as im_s_tabulated, sun_f_tabulated};
 
@@ -177,6 +180,8 @@ pub struct Analytic {
     extended: Vec<Extended>,
     /// The rule over each piece of a line or quad light, on [0, 1].
     rule: Rule,
+    /// The rule over each piece of a sphere light's surface, in z and φ.
+    sphere_rule: Rule,
     /// The occluders other than triangles, in f64 (for shadows).
     blockers: Vec<Blocker>,
     /// The meshes' triangles (for shadows).
@@ -205,12 +210,18 @@ impl Analytic {
                         use raymarch or stochastic, or render without shadows"
                 .into());
         }
-        if let Some(m) = scene.medium()
-            && let Density::Height { .. } = m.density
-        {
-            return Err("the analytic integrator needs a homogeneous medium; \
-                        this scene's is height fog: use raymarch"
-                .into());
+        if let Some(m) = scene.medium() {
+            let kind = match m.density {
+                Density::Homogeneous => None,
+                Density::Height { .. } => Some("height fog"),
+                Density::Grid(_) => Some("a density grid"),
+                Density::Noise(_) => Some("noise fog"),
+            };
+            if let Some(kind) = kind {
+                return Err(format!(
+                    "the analytic integrator needs a homogeneous medium; this scene's is {kind}: use raymarch"
+                ));
+            }
         }
         if options.light_steps == 0 {
             return Err("light_steps must be at least 1".into());
@@ -265,12 +276,14 @@ impl Analytic {
                         },
                         0.0,
                     )),
-                Light::Sphere { center, radius, radiance, .. } => emitters.push(point(
-                    center,
-                    radiance * (std::f32::consts::PI * radius * radius),
-                    Emission::Sphere { radius: radius as f64 },
-                    radius as f64,
-                )),
+                Light::Sphere { center, radius, radiance, .. } => extended.push(Extended::Sphere {
+                    center: center.as_dvec3(),
+                    radius: radius as f64,
+                    radiance: radiance.as_dvec3(),
+                    light: index,
+                    // Set below, once the occluders are known.
+                    near_surface: false,
+                }),
                 Light::Line { start, end, intensity } => {
                     let (a, b) = (start.as_dvec3(), end.as_dvec3());
                     extended.push(Extended::Line {
@@ -326,8 +339,20 @@ impl Analytic {
         let meshes = if options.shadows { MeshShadows::of_scene(scene) } else { MeshShadows::default() };
         if options.shadows {
             clearance::check_sphere_lights(scene.lights(), &blockers, &meshes)?;
+            for x in &mut extended {
+                if let Extended::Sphere { center, radius, light, near_surface, .. } = x {
+                    *near_surface = clearance::surface_near(*center, *radius, *light, &blockers, &meshes);
+                }
+            }
         }
-        Ok(Analytic { options, emitters, extended, rule, blockers, meshes })
+        // Half the points of a quad light per dimension: the sphere's rule
+        // spans its whole surface, but only where surfaces cast penumbrae.
+        let sphere_points = (n / 2).max(2);
+        let sphere_rule = match options.quadrature {
+            LightQuadrature::Gauss => Rule::gauss_legendre(sphere_points),
+            LightQuadrature::Uniform => Rule::uniform(sphere_points),
+        };
+        Ok(Analytic { options, emitters, extended, rule, sphere_rule, blockers, meshes })
     }
 
     /// Single-scattered radiance along `ray` over [0, t_end] from all lights.
@@ -363,6 +388,9 @@ impl Analytic {
                     }
                     Extended::Triangle { a, edge_1, edge_2, normal, intensity, light } => {
                         self.triangle_pieces(o, d, t_end, (a, edge_1, edge_2), normal, intensity, light, 0, &mut each)
+                    }
+                    Extended::Sphere { center, radius, radiance, light, near_surface } => {
+                        self.sphere_light(o, d, t_end, (center, radius), radiance, light, near_surface, &mut each)
                     }
                 }
             }

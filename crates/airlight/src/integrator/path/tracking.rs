@@ -77,13 +77,44 @@ fn exact_flights(
 
 /// A bound σ_maj ≥ σt(p) over the segment [t0, t1] of `ray`, per channel.
 /// Exact for a homogeneous medium; for the height fog, whose density is
-/// monotone along any line, the larger of the densities at the two ends.
+/// monotone along any line, the larger of the densities at the two ends;
+/// for a grid, its largest value; for noise, its bound over the segment.
 pub fn majorant(medium: &Medium, ray: &Ray, t0: f32, t1: f32) -> Rgb {
-    match medium.density {
+    match &medium.density {
         Density::Homogeneous => medium.sigma_t(),
         Density::Height { .. } => {
             let rho = medium.density_at(ray.at(t0)).max(medium.density_at(ray.at(t1)));
             medium.sigma_t() * rho
+        }
+        Density::Grid(grid) => medium.sigma_t() * grid.max_value(),
+        Density::Noise(noise) => {
+            let mut most = 0.0f32;
+            noise.majorant_segments(ray.origin, ray.dir, t0, t1, |_, _, bound| {
+                most = most.max(bound);
+                true
+            });
+            medium.sigma_t() * most
+        }
+    }
+}
+
+/// Calls `f(t0, t1, σ_maj)` for consecutive stretches of [0, t_max] of
+/// `ray` with a majorant each, until `f` returns false: one stretch for
+/// media that fill space; for a grid, one per majorant cell the ray
+/// crosses inside its box, and none outside (vacuum); for noise, its box
+/// cut into pieces (noise.rs).
+fn majorant_segments(medium: &Medium, ray: &Ray, t_max: f32, mut f: impl FnMut(f32, f32, Rgb) -> bool) {
+    match &medium.density {
+        Density::Grid(grid) => {
+            let sigma_t = medium.sigma_t();
+            grid.majorant_segments(ray.origin, ray.dir, 0.0, t_max, |t0, t1, bound| f(t0, t1, sigma_t * bound));
+        }
+        Density::Noise(noise) => {
+            let sigma_t = medium.sigma_t();
+            noise.majorant_segments(ray.origin, ray.dir, 0.0, t_max, |t0, t1, bound| f(t0, t1, sigma_t * bound));
+        }
+        _ => {
+            f(0.0, t_max, majorant(medium, ray, 0.0, t_max));
         }
     }
 }
@@ -103,7 +134,11 @@ pub struct Collision {
 /// Walks [0, t_max] of `ray` from collision to collision with the majorant,
 /// drawing free flights in channel `hero`, and calls `at` at each; stops
 /// early when `at` returns false. Returns the majorant transmittance from
-/// the last collision to t_max (all ones if stopped early).
+/// the last collision to t_max (all ones if stopped early). Across
+/// stretches with different majorants (a grid's majorant cells) a flight
+/// that passes a stretch's end starts afresh at the next one, which the
+/// exponential's lack of memory makes exact, and the majorant
+/// transmittances of the stretches passed multiply.
 pub fn track(
     medium: &Medium,
     ray: &Ray,
@@ -112,30 +147,39 @@ pub fn track(
     sampler: &mut Sampler,
     mut at: impl FnMut(Collision, &mut Sampler) -> bool,
 ) -> Rgb {
-    let sigma_maj = majorant(medium, ray, 0.0, t_max);
     let exp = |x: Rgb| Rgb::new((-x.x).exp(), (-x.y).exp(), (-x.z).exp());
-    if sigma_maj[hero] <= 0.0 {
-        return exp(sigma_maj * t_max);
-    }
-    let mut t = 0.0f32;
-    loop {
-        let step = -(1.0 - sampler.next()).ln() / sigma_maj[hero];
-        if t + step >= t_max {
-            return exp(sigma_maj * (t_max - t));
+    // Majorant transmittance since the last collision.
+    let mut since = Rgb::ONE;
+    let mut stopped = false;
+    majorant_segments(medium, ray, t_max, |t0, t1, sigma_maj| {
+        if sigma_maj[hero] <= 0.0 {
+            since *= exp(sigma_maj * (t1 - t0));
+            return true;
         }
-        t += step;
-        let density = medium.density_at(ray.at(t));
-        let collision = Collision {
-            t,
-            sigma_a: medium.sigma_a * density,
-            sigma_s: medium.sigma_s * density,
-            sigma_maj,
-            t_maj: exp(sigma_maj * step),
-        };
-        if !at(collision, sampler) {
-            return Rgb::ONE;
+        let mut t = t0;
+        loop {
+            let step = -(1.0 - sampler.next()).ln() / sigma_maj[hero];
+            if t + step >= t1 {
+                since *= exp(sigma_maj * (t1 - t));
+                return true;
+            }
+            t += step;
+            let density = medium.density_at(ray.at(t));
+            let collision = Collision {
+                t,
+                sigma_a: medium.sigma_a * density,
+                sigma_s: medium.sigma_s * density,
+                sigma_maj,
+                t_maj: since * exp(sigma_maj * step),
+            };
+            since = Rgb::ONE;
+            if !at(collision, sampler) {
+                stopped = true;
+                return false;
+            }
         }
-    }
+    });
+    if stopped { Rgb::ONE } else { since }
 }
 
 /// Whether a particle passes [0, t_max] without a real collision, by delta

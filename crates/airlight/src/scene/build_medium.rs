@@ -1,0 +1,197 @@
+//! The `[medium]` table: homogeneous fog, height fog, or a density grid
+//! read from a Mitsuba `.vol` file found under the scene's asset folders
+//! ([`super::assets`]). Errors name the scene's line and, for a grid file,
+//! what is wrong with it.
+
+use super::build::{Checker, Result};
+use super::desc::{MediumDesc, MediumType};
+use super::limits;
+use crate::medium::noise::MAX_OCTAVES;
+use crate::medium::{DensityGrid, Medium, NoiseFog, vol};
+use glam::Vec3;
+use toml::Spanned;
+
+impl Checker<'_> {
+    pub(super) fn medium(&self, desc: &Spanned<MediumDesc>) -> Result<Medium> {
+        let span = desc.span();
+        let m = desc.get_ref();
+        let sigma_a = self.non_negative3(span.clone(), "medium.sigma_a", m.sigma_a.map_or(Vec3::ZERO, |t| t.0))?;
+        let sigma_s = self.non_negative3(span.clone(), "medium.sigma_s", m.sigma_s.map_or(Vec3::ZERO, |t| t.0))?;
+        let g = m.g.unwrap_or(0.0);
+        if !(g > -1.0 && g < 1.0) {
+            return Err(self.err_field(span, "g", format!("medium.g must lie strictly between -1 and 1, got {g}")));
+        }
+        // Keys that belong to other types of medium, reported at the first.
+        let misplaced = |owner: &str, keys: &[(&str, bool)]| -> Result<()> {
+            match keys.iter().find(|(_, present)| *present) {
+                Some((key, _)) => Err(self.err_field(
+                    span.clone(),
+                    key,
+                    format!("medium.{key} belongs to a `{owner}` medium, not this one"),
+                )),
+                None => Ok(()),
+            }
+        };
+        let grid_keys = [
+            ("file", m.file.is_some()),
+            ("density_scale", m.density_scale.is_some()),
+            ("translate", m.translate.is_some()),
+            ("rotate", m.rotate.is_some()),
+            ("scale", m.scale.is_some()),
+        ];
+        let height_keys = [("base", m.base.is_some()), ("falloff", m.falloff.is_some())];
+        let noise_keys = [
+            ("octaves", m.octaves.is_some()),
+            ("gain", m.gain.is_some()),
+            ("offset", m.offset.is_some()),
+            ("seed", m.seed.is_some()),
+            ("min", m.min.is_some()),
+            ("max", m.max.is_some()),
+        ];
+        // `scale` belongs to both grid and noise.
+        let grid_only = &grid_keys[..4];
+        match m.kind {
+            MediumType::Homogeneous => {
+                if m.base.is_some() || m.falloff.is_some() {
+                    return Err(self.err_field(
+                        span,
+                        if m.base.is_some() { "base" } else { "falloff" },
+                        "base and falloff belong to a `height` medium, not a homogeneous one",
+                    ));
+                }
+                misplaced("grid", &grid_keys)?;
+                misplaced("noise", &noise_keys)?;
+                Ok(Medium::homogeneous(sigma_a, sigma_s, g))
+            }
+            MediumType::Height => {
+                misplaced("grid", &grid_keys)?;
+                misplaced("noise", &noise_keys)?;
+                let base = self.finite(span.clone(), "medium.base", m.base.unwrap_or(0.0))?;
+                let falloff = self.non_negative(span, "medium.falloff", m.falloff.unwrap_or(0.5))?;
+                Ok(Medium::height(sigma_a, sigma_s, g, base, falloff))
+            }
+            MediumType::Grid => {
+                misplaced("height", &height_keys)?;
+                misplaced("noise", &noise_keys)?;
+                Ok(Medium::grid(sigma_a, sigma_s, g, self.density_grid(desc)?))
+            }
+            MediumType::Noise => {
+                misplaced("grid", grid_only)?;
+                Ok(Medium::noise(sigma_a, sigma_s, g, self.noise_fog(desc)?))
+            }
+        }
+    }
+
+    /// The grid of a `type = "grid"` medium: its file read and checked,
+    /// scaled by `density_scale` and placed by `translate`, `rotate`, `scale`.
+    fn density_grid(&self, desc: &Spanned<MediumDesc>) -> Result<DensityGrid> {
+        let span = desc.span();
+        let m = desc.get_ref();
+        let Some(file) = &m.file else {
+            return Err(self.err(span, "a `grid` medium needs `file`, a Mitsuba .vol density grid"));
+        };
+        let density_scale = self.non_negative(span.clone(), "medium.density_scale", m.density_scale.unwrap_or(1.0))?;
+        let transform = self.transform_parts(span.clone(), "medium", m.translate, m.rotate, m.scale)?;
+        let name = file.get_ref();
+        let err = |why: String| self.err(file.span(), format!("medium.file: cannot load grid `{name}`: {why}"));
+        if !name.to_ascii_lowercase().ends_with(".vol") {
+            return Err(err("a grid file must be a Mitsuba volume ending in .vol".into()));
+        }
+        let path = self.assets.resolve(name).map_err(|why| self.err(file.span(), format!("medium.file: {why}")))?;
+        let open = std::fs::File::open(&path).map_err(|e| err(e.to_string()))?;
+        let length = open.metadata().map_err(|e| err(e.to_string()))?.len();
+        let mut grid = vol::read(std::io::BufReader::new(open), length).map_err(err)?;
+        if density_scale != 1.0 {
+            for v in &mut grid.values {
+                *v *= density_scale;
+            }
+            if let Some(big) = grid.values.iter().find(|v| !v.is_finite()) {
+                return Err(err(format!("density_scale {density_scale} makes a density {big}")));
+            }
+        }
+        let (min, max) = (grid.min, grid.max);
+        let grid = DensityGrid::new(grid.resolution, grid.values, min, max, transform)
+            .ok_or_else(|| err("its box, placed by the transform, is degenerate".into()))?;
+        let reach = grid.corners().into_iter().map(limits::reach_of).fold(0.0, f32::max);
+        if reach > limits::MAX_COORDINATE {
+            return Err(err(limits::too_far("the grid's box", reach)));
+        }
+        self.files.borrow_mut().push(path);
+        Ok(grid)
+    }
+
+    /// The fog of a `type = "noise"` medium, its parameters checked.
+    fn noise_fog(&self, desc: &Spanned<MediumDesc>) -> Result<NoiseFog> {
+        let span = desc.span();
+        let m = desc.get_ref();
+        let scale = m.scale.map_or(Vec3::ONE, |s| s.0);
+        if !(scale.is_finite() && scale.min_element() > 0.0) {
+            return Err(self.err_field(span, "scale", format!("medium.scale must be finite and > 0, got {scale}")));
+        }
+        let octaves = match &m.octaves {
+            None => 4,
+            Some(o) if (1..=MAX_OCTAVES as i64).contains(o.get_ref()) => *o.get_ref() as u32,
+            Some(o) => {
+                return Err(self.err(
+                    o.span(),
+                    format!("medium.octaves must be an integer from 1 to {MAX_OCTAVES}, got {}", o.get_ref()),
+                ));
+            }
+        };
+        let gain = m.gain.unwrap_or(0.5);
+        if !(0.0..=1.0).contains(&gain) {
+            return Err(self.err_field(span, "gain", format!("medium.gain must lie in [0, 1], got {gain}")));
+        }
+        let offset = self.finite(span.clone(), "medium.offset", m.offset.unwrap_or(0.0))?;
+        let seed = match &m.seed {
+            None => 0,
+            Some(s) => u32::try_from(*s.get_ref()).map_err(|_| {
+                self.err(
+                    s.span(),
+                    format!("medium.seed must be an integer from 0 to {}, got {}", u32::MAX, s.get_ref()),
+                )
+            })?,
+        };
+        let bounds = match (m.min, m.max) {
+            (None, None) => None,
+            (Some(lo), Some(hi)) => {
+                let lo = self.finite3(span.clone(), "medium.min", lo.0)?;
+                let hi = self.finite3(span.clone(), "medium.max", hi.0)?;
+                if !hi.cmpgt(lo).all() {
+                    return Err(self.err_field(
+                        span,
+                        "max",
+                        format!("medium.max {hi} must exceed medium.min {lo} on every axis"),
+                    ));
+                }
+                let reach = limits::reach_of(lo).max(limits::reach_of(hi));
+                if reach > limits::MAX_COORDINATE {
+                    return Err(self.err_field(span, "max", limits::too_far("the noise fog's box", reach)));
+                }
+                Some((lo, hi))
+            }
+            _ => {
+                return Err(self.err_field(
+                    span,
+                    if m.min.is_some() { "min" } else { "max" },
+                    "a noise fog's box needs both min and max",
+                ));
+            }
+        };
+        let height = match m.falloff {
+            None if m.base.is_some() => {
+                return Err(self.err_field(
+                    span,
+                    "base",
+                    "medium.base needs a falloff: the height factor is exp(−falloff·(y − base))",
+                ));
+            }
+            None => None,
+            Some(falloff) => {
+                let falloff = self.non_negative(span.clone(), "medium.falloff", falloff)?;
+                Some((self.finite(span, "medium.base", m.base.unwrap_or(0.0))?, falloff))
+            }
+        };
+        Ok(NoiseFog { scale, octaves, gain, offset, seed, bounds, height })
+    }
+}
