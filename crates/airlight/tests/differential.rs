@@ -24,7 +24,10 @@
 //! `AIRLIGHT_DIFF_RENDER_SEED=R` renders with other random numbers (a
 //! disagreement that another seed does not repeat is noise: the allowance is
 //! 5 standard errors estimated from few samples, and path-traced pixels
-//! have heavy tails, so among 75,000 comparisons a few pass 5). A disagreement prints
+//! have heavy tails, so among 75,000 comparisons a few pass 5);
+//! `AIRLIGHT_DIFF_REFERENCE_SPP=N` renders the raymarch reference at N
+//! samples, `AIRLIGHT_DIFF_LIGHT=k` keeps only light k, and
+//! `AIRLIGHT_DIFF_DEBUG=1` prints each block's means. A disagreement prints
 //! the seed. Cases it found are kept below as named tests.
 
 use airlight::film::Accumulator;
@@ -240,7 +243,12 @@ fn check(seed: u64) -> Result<Vec<(&'static str, f64)>, String> {
     }
     let mut results = Vec::new();
     let mut fail = Vec::new();
-    let reference = render(&mut scene, IntegratorKind::Raymarch, 16, 1)?;
+    let reference = render(
+        &mut scene,
+        IntegratorKind::Raymarch,
+        std::env::var("AIRLIGHT_DIFF_REFERENCE_SPP").ok().and_then(|s| s.parse().ok()).unwrap_or(16),
+        1,
+    )?;
     // The closed form takes a sphere light as a point at its centre of
     // intensity πR²L: exact without extinction and with isotropic
     // scattering, off by O(σt·R) otherwise (its documented approximation).
