@@ -1,9 +1,10 @@
-//! `render --aov`: the first-hit outputs (albedo, normal, depth) and the
-//! variance, written as layers of the render's EXR images.
+//! `render --aov`: the first-hit outputs (albedo, normal, depth), the
+//! variance and the in-scattered light, written as layers of the render's
+//! EXR images.
 
-use airlight::aov::{Aov, SurfaceAovs, surface_aovs};
+use airlight::aov::{Aov, SurfaceAovs, in_scattered_aov, surface_aovs};
 use airlight::film::Image;
-use airlight::integrator::Integrator;
+use airlight::integrator::{Integrator, IntegratorKind};
 use airlight::scene::Scene;
 use std::ops::Range;
 use std::path::{Path, PathBuf};
@@ -21,9 +22,17 @@ pub fn is_exr(path: &Path) -> bool {
 }
 
 /// Refuses AOVs that no output would hold, or a partial render's.
-pub fn check(aovs: &[Aov], outputs: &[PathBuf], partial: bool) -> Result<(), String> {
+pub fn check(aovs: &[Aov], outputs: &[PathBuf], partial: bool, integrator: IntegratorKind) -> Result<(), String> {
     if aovs.is_empty() {
         return Ok(());
+    }
+    let single_scattering =
+        matches!(integrator, IntegratorKind::Raymarch | IntegratorKind::Analytic | IntegratorKind::Stochastic);
+    if aovs.contains(&Aov::Inscatter) && !single_scattering {
+        return Err(format!(
+            "--aov inscatter: the {integrator} integrator does not separate the medium's light; \
+             use raymarch, analytic or stochastic"
+        ));
     }
     if partial {
         return Err("--aov: a shard or tile is a partial EXR of sums; render the AOVs with the merged image's \
@@ -40,11 +49,12 @@ pub fn check(aovs: &[Aov], outputs: &[PathBuf], partial: bool) -> Result<(), Str
 pub struct Layers {
     aovs: Vec<Aov>,
     surface: Option<SurfaceAovs>,
+    in_scattered: Option<Image>,
 }
 
 impl Layers {
     pub fn none() -> Self {
-        Layers { aovs: Vec::new(), surface: None }
+        Layers { aovs: Vec::new(), surface: None, in_scattered: None }
     }
 
     /// The first-hit outputs of the frame, over the camera rays of its
@@ -58,9 +68,15 @@ impl Layers {
     ) -> Self {
         let surface = aovs
             .iter()
-            .any(|a| *a != Aov::Variance)
-            .then(|| pool.install(|| surface_aovs(scene, integrator.stratified(), samples)));
-        Layers { aovs: aovs.to_vec(), surface }
+            .any(|a| matches!(a, Aov::Albedo | Aov::Normal | Aov::Depth))
+            .then(|| pool.install(|| surface_aovs(scene, integrator.stratified(), samples.clone())));
+        // A second pass over the render's own samples (as costly as the
+        // render): checked to be possible in `check`.
+        let in_scattered = aovs
+            .contains(&Aov::Inscatter)
+            .then(|| pool.install(|| in_scattered_aov(scene, integrator, samples)))
+            .flatten();
+        Layers { aovs: aovs.to_vec(), surface, in_scattered }
     }
 
     pub fn wants_variance(&self) -> bool {
@@ -78,6 +94,10 @@ impl Layers {
             let values = match (aov, &self.surface, variance) {
                 (Aov::Variance, _, Some(v)) => (0..3).map(|c| v.pixels.iter().map(|p| p[c]).collect()).collect(),
                 (Aov::Variance, _, None) => continue,
+                (Aov::Inscatter, _, _) => match &self.in_scattered {
+                    Some(image) => (0..3).map(|c| image.pixels.iter().map(|p| p[c]).collect()).collect(),
+                    None => continue,
+                },
                 (_, Some(surface), _) => surface.channels(aov).unwrap_or_default(),
                 (_, None, _) => continue,
             };

@@ -98,12 +98,19 @@ pub struct RenderArgs {
     /// analytic: gauss (Gauss–Legendre) or uniform (equal steps) over lights.
     #[arg(long, value_parser = parse_light_quadrature)]
     light_quadrature: Option<LightQuadrature>,
+    /// A medium instead of the scene's (a glTF file has none): the keys of
+    /// a scene file's [medium] as `key=value` pairs separated by commas,
+    /// e.g. `sigma_s=0.05,sigma_a=0.01,g=0.3`, `sigma_s=[0.1,0.1,0.2]` or
+    /// `type="height",sigma_s=0.2,falloff=0.5`; `none` for no medium.
+    #[arg(long, value_name = "KEY=VALUE,...", value_parser = parse_medium)]
+    medium: Option<MediumOption>,
     /// Worker threads (default: all cores). The image does not depend on it.
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=crate::preflight::MAX_THREADS as i64))]
     threads: Option<u32>,
     /// Also write, as layers of each .exr output, what the camera's first
     /// hits are: a comma-separated list of albedo, normal, depth and
-    /// variance (variance implies --progressive)
+    /// variance (variance implies --progressive); and inscatter, the
+    /// medium's light alone (raymarch, analytic, stochastic)
     #[arg(long, value_name = "LIST", value_parser = crate::aovs::parse_list)]
     aov: Option<crate::aovs::AovList>,
     /// No progress bar or summary.
@@ -202,7 +209,7 @@ pub fn render(args: RenderArgs) -> Result<(), String> {
     let aovs = args.aov.clone().map(|list| list.0).unwrap_or_default();
     let progressive =
         args.progressive || args.target_error.is_some() || args.variance.is_some() || aovs.contains(&Aov::Variance);
-    crate::aovs::check(&aovs, &outputs, plan.partial)?;
+    crate::aovs::check(&aovs, &outputs, plan.partial, desc.kind)?;
     let (files, variance) = (scene.files(), args.variance.as_deref());
     crate::outputs::check_render(args.scene.as_deref(), files, &outputs, variance, args.frames)?;
     crate::preflight::render_memory(&scene, progressive)?;
@@ -340,7 +347,21 @@ fn configure(args: &RenderArgs) -> Result<SceneFile, String> {
     if let Some(model) = args.attenuation {
         file.scene.set_attenuation_model(model).map_err(|e| format!("--attenuation: {e}"))?;
     }
+    if let Some(MediumOption(medium)) = &args.medium {
+        file.scene.set_medium(medium.clone());
+    }
     Ok(file)
+}
+
+/// `--medium`: a medium, or None for `none`.
+#[derive(Clone, Debug)]
+pub struct MediumOption(Option<airlight::medium::Medium>);
+
+fn parse_medium(s: &str) -> Result<MediumOption, String> {
+    if s.trim() == "none" {
+        return Ok(MediumOption(None));
+    }
+    airlight::scene::medium_from_options(s).map(|m| MediumOption(Some(m)))
 }
 
 /// The image outputs: as given, or NAME.png after the scene file.

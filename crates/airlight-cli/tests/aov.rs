@@ -115,3 +115,32 @@ fn aovs_are_layers_of_the_exr_with_standard_names() {
     assert!(String::from_utf8_lossy(&shard.stderr).contains("a shard or tile is a partial EXR"));
     assert!(!dir.path().join("a.exr").exists() && !dir.path().join("p.exr").exists());
 }
+
+#[test]
+fn the_in_scattered_light_is_a_layer_for_single_scattering_integrators() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("s.toml"), SCENE).unwrap();
+    let fog = ["--medium", "sigma_s=0.2,sigma_a=0.05", "--steps", "8", "--spp", "2", "-q"];
+    let run = airlight(
+        dir.path(),
+        &[&["render", "s.toml", "--integrator", "raymarch", "--aov", "inscatter,depth", "-o", "fog.exr"], &fog[..]]
+            .concat(),
+    );
+    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+    let c = channels(&dir.path().join("fog.exr"));
+    let mut names: Vec<&str> = c.keys().map(String::as_str).collect();
+    names.sort();
+    assert_eq!(names, ["B", "G", "R", "Z", "inscatter.B", "inscatter.G", "inscatter.R"]);
+    // Part of the image, never more; the floor's light is the rest.
+    for (i, (&r, &s)) in c["R"].iter().zip(&c["inscatter.R"]).enumerate() {
+        assert!(s > 0.0 && s <= r * (1.0 + 1e-5), "pixel {i}: image {r}, in-scattered {s}");
+    }
+    assert!(c["R"].iter().zip(&c["inscatter.R"]).any(|(r, s)| r - s > 0.01), "no surface light left");
+    let path = airlight(
+        dir.path(),
+        &[&["render", "s.toml", "--integrator", "path", "--aov", "inscatter", "-o", "p.exr"], &fog[..]].concat(),
+    );
+    let err = String::from_utf8_lossy(&path.stderr);
+    assert!(err.contains("--aov inscatter: the path integrator does not separate the medium's light"), "{err}");
+    assert!(!dir.path().join("p.exr").exists());
+}

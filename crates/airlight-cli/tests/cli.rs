@@ -113,3 +113,37 @@ fn info_describes_a_scene() {
     let text = String::from_utf8(out.stdout).unwrap();
     assert!(text.contains("640×480") && text.contains("lights: 1"), "{text}");
 }
+
+#[test]
+fn medium_puts_fog_into_a_gltf_as_a_scene_file_would() {
+    // The Blender-exported glTF with --medium, against the same file
+    // included by a scene file that says [medium]: the same image, byte
+    // for byte; without the option, a different one.
+    let dir = tempfile::tempdir().unwrap();
+    let models = scenes().join("models");
+    std::fs::copy(models.join("blender_room.glb"), dir.path().join("room.glb")).unwrap();
+    std::fs::write(
+        dir.path().join("fog.toml"),
+        "[render]\nwidth = 32\nheight = 24\n[medium]\nsigma_s = [0.05, 0.05, 0.1]\nsigma_a = 0.01\ng = 0.3\n\
+         [[include]]\nfile = \"room.glb\"\n",
+    )
+    .unwrap();
+    let common = ["--width", "32", "--height", "24", "--spp", "2", "--integrator", "raymarch", "--steps", "8", "-q"];
+    let run = |args: &[&str]| {
+        let out = airlight(dir.path(), &[&["render"], args, &common[..]].concat());
+        assert!(out.status.success(), "{args:?}: {}", String::from_utf8_lossy(&out.stderr));
+    };
+    run(&["room.glb", "--medium", "sigma_s=[0.05,0.05,0.1],sigma_a=0.01,g=0.3", "-o", "option.exr"]);
+    run(&["fog.toml", "-o", "file.exr"]);
+    run(&["room.glb", "-o", "clear.exr"]);
+    run(&["fog.toml", "--medium", "none", "-o", "removed.exr"]);
+    let read = |name: &str| std::fs::read(dir.path().join(name)).unwrap();
+    assert!(read("option.exr") == read("file.exr"), "--medium and [medium] differ");
+    assert!(read("option.exr") != read("clear.exr"), "--medium changed nothing");
+    assert!(read("removed.exr") == read("clear.exr"), "--medium none left fog");
+    // Checked by the scene file's rules.
+    let out = airlight(dir.path(), &["render", "room.glb", "--medium", "sigma_s=0.1,g=1.5", "-o", "x.exr"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success() && err.contains("medium.g must lie strictly between -1 and 1, got 1.5"), "{err}");
+    assert!(!dir.path().join("x.exr").exists());
+}

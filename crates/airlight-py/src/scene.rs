@@ -216,7 +216,9 @@ fn image_array<'py>(py: Python<'py>, image: &airlight::Image) -> PyResult<Bound<
 fn aov_list(arg: Option<&Bound<'_, PyAny>>) -> PyResult<Vec<Aov>> {
     let Some(arg) = arg.filter(|a| !a.is_none()) else { return Ok(Vec::new()) };
     if let Ok(flag) = arg.cast::<pyo3::types::PyBool>() {
-        return Ok(if flag.is_true() { Aov::ALL.to_vec() } else { Vec::new() });
+        // All that Python computes (not `inscatter`, below).
+        let all = Aov::ALL.into_iter().filter(|a| *a != Aov::Inscatter).collect();
+        return Ok(if flag.is_true() { all } else { Vec::new() });
     }
     let list = if let Ok(s) = arg.cast::<pyo3::types::PyString>() {
         s.to_cow()?.into_owned()
@@ -229,7 +231,13 @@ fn aov_list(arg: Option<&Bound<'_, PyAny>>) -> PyResult<Vec<Aov>> {
         })?;
         names.join(",")
     };
-    Aov::parse_list(&list).map_err(|e| PyValueError::new_err(format!("aovs: {e}")))
+    let aovs = Aov::parse_list(&list).map_err(|e| PyValueError::new_err(format!("aovs: {e}")))?;
+    if aovs.contains(&Aov::Inscatter) {
+        return Err(PyValueError::new_err(
+            "aovs: inscatter is not computed from Python yet; `airlight render --aov inscatter` writes it",
+        ));
+    }
+    Ok(aovs)
 }
 
 #[pymethods]
@@ -430,7 +438,7 @@ impl PyScene {
                 ));
             }
             let variance = aovs.contains(&Aov::Variance);
-            let surface = aovs.iter().any(|a| *a != Aov::Variance);
+            let surface = aovs.iter().any(|a| matches!(a, Aov::Albedo | Aov::Normal | Aov::Depth));
             // As the CLI does before it renders: an image too large for
             // memory is refused, a scene that can only be black is warned of.
             let pixels = settings.width as u64 * settings.height as u64;
@@ -469,6 +477,7 @@ impl PyScene {
                             .map_err(|e| crate::errors::internal_error(&format!("depth buffer: {e}")))?;
                         PyArray2::from_owned_array(py, depth).into_any()
                     }
+                    Aov::Inscatter => return Err(missing()),
                 };
                 out.set_item(aov.name(), value)?;
             }

@@ -74,8 +74,12 @@ def test_aovs_give_named_arrays_beside_the_color(fog):
     assert list(some) == ["color", "depth", "albedo"]
     assert np.array_equal(some["depth"], out["depth"])
     assert list(fog.render(**SMALL, aovs=["normal"])) == ["color", "normal"]
-    with pytest.raises(ValueError, match="^aovs: unknown AOV `colour`; known: albedo, normal, depth, variance$"):
+    with pytest.raises(
+        ValueError, match="^aovs: unknown AOV `colour`; known: albedo, normal, depth, variance, inscatter$"
+    ):
         fog.render(**SMALL, aovs="colour")
+    with pytest.raises(ValueError, match="^aovs: inscatter is not computed from Python yet"):
+        fog.render(**SMALL, aovs="depth,inscatter")
     with pytest.raises(ValueError, match="without shard"):
         fog.render(**SMALL, aovs=True, shard=(0, 2))
 

@@ -36,7 +36,7 @@ fn displaced_sphere(n: u32) -> Shape {
             triangles.push([a + 1, b, b + 1]);
         }
     }
-    Shape::Mesh { positions, triangles }
+    Shape::Mesh { positions, triangles, uvs: Vec::new() }
 }
 
 fn main() {

@@ -4,10 +4,13 @@
 //! the same camera rays (anti-aliasing and lens samples) as the render, so
 //! edges line up with it. Written as layers of one multi-layer EXR with the
 //! channel names compositors (Blender, Nuke) and Intel Open Image Denoise's
-//! tools expect: `albedo.R/G/B`, `N.X/Y/Z`, `Z`, `variance.R/G/B`.
+//! tools expect: `albedo.R/G/B`, `N.X/Y/Z`, `Z`, `variance.R/G/B`; and,
+//! for the single-scattering integrators, the medium's light alone,
+//! `inscatter.R/G/B`.
 
 use crate::Rgb;
 use crate::film::Image;
+use crate::integrator::Integrator;
 use crate::scene::Scene;
 use glam::Vec3;
 use rayon::prelude::*;
@@ -29,10 +32,15 @@ pub enum Aov {
     /// The estimated variance of each pixel's mean, per channel (from a
     /// progressive render's accumulated samples).
     Variance,
+    /// The light the medium scatters toward the camera, alone: the
+    /// single-scattering integrators' in-scattered term, from the same
+    /// samples as the render, so that the image minus it is the surfaces'
+    /// light as it reaches the camera through the medium.
+    Inscatter,
 }
 
 impl Aov {
-    pub const ALL: [Aov; 4] = [Aov::Albedo, Aov::Normal, Aov::Depth, Aov::Variance];
+    pub const ALL: [Aov; 5] = [Aov::Albedo, Aov::Normal, Aov::Depth, Aov::Variance, Aov::Inscatter];
 
     pub fn name(self) -> &'static str {
         match self {
@@ -40,6 +48,7 @@ impl Aov {
             Aov::Normal => "normal",
             Aov::Depth => "depth",
             Aov::Variance => "variance",
+            Aov::Inscatter => "inscatter",
         }
     }
 
@@ -50,6 +59,7 @@ impl Aov {
             Aov::Normal => &["N.X", "N.Y", "N.Z"],
             Aov::Depth => &["Z"],
             Aov::Variance => &["variance.R", "variance.G", "variance.B"],
+            Aov::Inscatter => &["inscatter.R", "inscatter.G", "inscatter.B"],
         }
     }
 
@@ -82,14 +92,14 @@ pub struct SurfaceAovs {
 
 impl SurfaceAovs {
     /// The channels of `aov` (row-major, one vector per channel); None for
-    /// [`Aov::Variance`], which the render's samples give.
+    /// [`Aov::Variance`] and [`Aov::Inscatter`], which the render's samples give.
     pub fn channels(&self, aov: Aov) -> Option<Vec<Vec<f32>>> {
         let split = |image: &Image| (0..3).map(|c| image.pixels.iter().map(|p| p[c]).collect()).collect();
         match aov {
             Aov::Albedo => Some(split(&self.albedo)),
             Aov::Normal => Some(split(&self.normal)),
             Aov::Depth => Some(vec![self.depth.clone()]),
-            Aov::Variance => None,
+            Aov::Variance | Aov::Inscatter => None,
         }
     }
 }
@@ -131,9 +141,38 @@ pub fn surface_aovs(scene: &Scene, stratified: bool, samples: Range<u64>) -> Sur
     }
 }
 
+/// The in-scattered light ([`Aov::Inscatter`]) averaged over samples
+/// `samples` of every pixel, drawn exactly as a render of `integrator`
+/// draws them (the same samplers, camera rays and order), so that each
+/// pixel of the render minus it is the surface part of the same samples.
+/// None when the integrator does not separate the two
+/// ([`Integrator::radiance_parts`]).
+pub fn in_scattered_aov(scene: &Scene, integrator: &dyn Integrator, samples: Range<u64>) -> Option<Image> {
+    let s = scene.settings();
+    let (width, height) = (s.width, s.height);
+    let stratified = integrator.stratified();
+    let pixels: Option<Vec<Rgb>> = (0..width as usize * height as usize)
+        .into_par_iter()
+        .map(|index| {
+            let (x, y) = ((index % width as usize) as u32, (index / width as usize) as u32);
+            // Summed as the render sums (fixed point): the same samples give
+            // the same mean, bit for bit.
+            let mut sum = crate::film::PixelSum::default();
+            for i in samples.clone() {
+                let mut sampler = crate::sampling::Sampler::for_pixel(s.seed, index as u64, i);
+                let ray = crate::render::camera_ray(scene, stratified, x, y, &mut sampler);
+                sum.add(integrator.radiance_parts(scene, &ray, &mut sampler)?.in_scattered);
+            }
+            Some(sum.mean())
+        })
+        .collect();
+    Some(Image { width, height, pixels: pixels? })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::integrator::{IntegratorDesc, IntegratorKind};
     use crate::prelude::*;
     use crate::scene::RenderSettings;
 
@@ -172,5 +211,92 @@ mod tests {
         assert_eq!(Aov::parse_list("depth,variance").unwrap(), vec![Aov::Depth, Aov::Variance]);
         assert!(Aov::parse_list("albedo,colour").unwrap_err().contains("unknown AOV `colour`"));
         assert!(Aov::parse_list(" , ").is_err());
+    }
+
+    /// The floor scene in fog, or without the floor, or in vacuum.
+    fn foggy(floor: bool, fog: bool) -> Scene {
+        let mut settings = RenderSettings::default();
+        (settings.width, settings.height, settings.max_distance) = (6, 6, 8.0);
+        let mut b = SceneBuilder::new()
+            .settings(settings)
+            .camera(Camera::look_at(Vec3::new(0.0, 2.0, -3.0), Vec3::ZERO, Vec3::Y, 50.0))
+            .material("red", Material::diffuse(Rgb::new(0.6, 0.1, 0.05)))
+            .light(Light::point(Vec3::new(0.3, 1.0, 0.2), Rgb::splat(2.0)));
+        if floor {
+            b = b.object(crate::geometry::Shape::plane(Vec3::ZERO, Vec3::Y), "red");
+        }
+        if fog {
+            b = b.medium(crate::medium::Medium::homogeneous(Rgb::splat(0.05), Rgb::new(0.2, 0.3, 0.4), 0.2));
+        }
+        b.build().unwrap()
+    }
+
+    fn single_scattering(scene: &Scene) -> Vec<(IntegratorKind, Box<dyn Integrator>)> {
+        [IntegratorKind::Raymarch, IntegratorKind::Analytic, IntegratorKind::Stochastic]
+            .into_iter()
+            .map(|kind| (kind, IntegratorDesc::new(kind).build(scene).unwrap()))
+            .collect()
+    }
+
+    #[test]
+    fn in_scattered_light_is_the_whole_image_without_surfaces_and_nothing_in_vacuum() {
+        let samples = 0..4;
+        // Only fog: the image is its in-scattered light, sample for sample.
+        let scene = foggy(false, true);
+        for (kind, integrator) in single_scattering(&scene) {
+            let beauty =
+                crate::render::accumulate(&scene, integrator.as_ref(), samples.clone(), 0..6, &Default::default());
+            let aov = in_scattered_aov(&scene, integrator.as_ref(), samples.clone()).unwrap();
+            for (i, p) in aov.pixels.iter().enumerate() {
+                let b = beauty.pixel(i as u32 % 6, i as u32 / 6).unwrap().mean();
+                assert_eq!(*p, b, "{kind}: pixel {i}");
+            }
+            assert!(aov.pixels.iter().all(|p| p.min_element() > 0.0), "{kind}: the fog is dark");
+        }
+        // Vacuum: nothing in-scattered, while the floor is lit.
+        let scene = foggy(true, false);
+        for (kind, integrator) in single_scattering(&scene) {
+            let aov = in_scattered_aov(&scene, integrator.as_ref(), samples.clone()).unwrap();
+            assert!(aov.pixels.iter().all(|p| *p == Rgb::ZERO), "{kind}");
+            let beauty =
+                crate::render::accumulate(&scene, integrator.as_ref(), samples.clone(), 0..6, &Default::default());
+            assert!(beauty.pixel(3, 5).unwrap().mean().x > 0.0, "{kind}: the floor is dark");
+        }
+        // Integrators that do not separate the two say so.
+        let path = IntegratorDesc::new(IntegratorKind::Path).build(&scene).unwrap();
+        assert!(in_scattered_aov(&scene, path.as_ref(), samples).is_none());
+    }
+
+    #[test]
+    fn the_image_is_the_surface_part_plus_the_in_scattered_light() {
+        // Floor and fog: per sample, radiance = surface part + in-scattered
+        // part; so per pixel, the image minus the AOV is the mean of the
+        // surfaces' parts, drawn here sample by sample.
+        let scene = foggy(true, true);
+        let samples = 0..4u64;
+        for (kind, integrator) in single_scattering(&scene) {
+            let beauty =
+                crate::render::accumulate(&scene, integrator.as_ref(), samples.clone(), 0..6, &Default::default());
+            let aov = in_scattered_aov(&scene, integrator.as_ref(), samples.clone()).unwrap();
+            let mut floor_seen = false;
+            for (i, in_scattered) in aov.pixels.iter().enumerate() {
+                let (x, y) = (i as u32 % 6, i as u32 / 6);
+                let mut surface = glam::DVec3::ZERO;
+                for k in samples.clone() {
+                    let mut sampler = crate::sampling::Sampler::for_pixel(scene.settings().seed, i as u64, k);
+                    let ray = crate::render::camera_ray(&scene, integrator.stratified(), x, y, &mut sampler);
+                    surface += integrator.radiance_parts(&scene, &ray, &mut sampler).unwrap().surface.as_dvec3();
+                }
+                let surface = (surface / samples.end as f64).as_vec3();
+                floor_seen |= surface.x > 0.0;
+                let b = beauty.pixel(x, y).unwrap().mean();
+                assert!(
+                    (b - (surface + *in_scattered)).abs().max_element() <= 1e-5 * b.max_element().max(1.0),
+                    "{kind}: pixel {i}: {b} vs {surface} + {in_scattered}"
+                );
+                assert!(in_scattered.min_element() > 0.0);
+            }
+            assert!(floor_seen, "{kind}: no floor");
+        }
     }
 }

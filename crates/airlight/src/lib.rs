@@ -43,6 +43,7 @@ pub mod render;
 pub mod sampling;
 pub mod scene;
 mod scene_file;
+pub mod texture;
 
 /// Linear RGB radiance, irradiance or reflectance.
 pub type Rgb = glam::Vec3;

@@ -1,10 +1,12 @@
 //! Surface materials. All reflect on both sides (docs/scene-format.md: two-sided).
 
 use crate::Rgb;
+use crate::texture::Texture;
 use glam::Vec3;
 use std::f32::consts::PI;
+use std::sync::Arc;
 
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub enum Material {
     /// Lambertian: BRDF = albedo/π.
     Diffuse { albedo: Rgb },
@@ -15,6 +17,12 @@ pub enum Material {
     /// The (n+2)/(2π) makes the lobe's directional albedo at normal
     /// incidence equal `specular`, as in the ray-marching post's setUpPhongIllumination.
     Phong { albedo: Rgb, specular: Rgb, exponent: f32 },
+    /// Lambertian with an image texture: albedo = `factor` × the texture's
+    /// bilinearly filtered linear colour at the hit's texture coordinates
+    /// ([`crate::Scene::material_at`] resolves it per hit). A surface
+    /// without texture coordinates (a sphere, a mesh without them) takes
+    /// `factor` × the texture's mean colour.
+    Textured { factor: Rgb, texture: Arc<Texture> },
 }
 
 impl Material {
@@ -27,12 +35,29 @@ impl Material {
     pub fn phong(albedo: Rgb, specular: Rgb, exponent: f32) -> Self {
         Material::Phong { albedo, specular, exponent }
     }
+    pub fn textured(factor: Rgb, texture: Arc<Texture>) -> Self {
+        Material::Textured { factor, texture }
+    }
     /// The black surface of an area light.
     pub const BLACK: Material = Material::Diffuse { albedo: Rgb::ZERO };
 
-    /// The diffuse albedo at point `p` with outward normal `n`.
+    /// This material at texture coordinates `uv` (if the surface has
+    /// them): a textured material becomes the diffuse one it is there;
+    /// others are themselves.
+    pub fn at_uv(&self, uv: Option<glam::Vec2>) -> Material {
+        match (self, uv) {
+            (Material::Textured { factor, texture }, Some(uv)) => {
+                Material::Diffuse { albedo: *factor * texture.sample(uv.x, uv.y) }
+            }
+            _ => self.clone(),
+        }
+    }
+
+    /// The diffuse albedo at point `p` with outward normal `n` (a textured
+    /// material: its mean; see [`Material::at_uv`]).
     pub fn albedo(&self, p: Vec3, n: Vec3) -> Rgb {
         match *self {
+            Material::Textured { factor, ref texture } => factor * texture.mean(),
             Material::Diffuse { albedo } | Material::Phong { albedo, .. } => albedo,
             Material::Checker { albedo, albedo2, scale } => {
                 // Step half a square inward so that points on a face that lies

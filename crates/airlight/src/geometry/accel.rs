@@ -7,7 +7,7 @@ use super::Ray;
 use super::bvh4::{self, BoxRay, Bvh4};
 use super::sdf::{Sdf, sphere_trace};
 use super::shape::{Shape, box_normal, intersect_box, intersect_quad, intersect_sphere, intersect_triangle};
-use glam::{Affine3A, Mat3, Vec3, Vec3A};
+use glam::{Affine3A, Mat3, Vec2, Vec3, Vec3A};
 use obvhs::{Boundable, BvhBuildParams, aabb::Aabb};
 use std::time::Duration;
 
@@ -60,7 +60,14 @@ struct Record {
     prim: Prim,
     material: u32,
     emitter: Option<u32>,
+    /// A triangle's texture coordinates: its index in `Geometry::triangle_uvs`,
+    /// or [`NO_UV`]. (The field fits in the record's padding: meshes
+    /// without texture coordinates cost nothing more.)
+    uv: u32,
 }
+
+/// A record without texture coordinates of its own.
+const NO_UV: u32 = u32::MAX;
 
 /// An SDF that no box bounds (it holds a plane): traced on its own.
 #[derive(Clone, Debug)]
@@ -179,6 +186,10 @@ pub struct SurfaceHit {
     pub material: u32,
     /// The light this surface belongs to, if it is an area light's surface.
     pub emitter: Option<u32>,
+    /// Texture coordinates: a mesh's that has them, interpolated; a quad's
+    /// (α, 1 − β) for the point corner + α·edge_u + β·edge_v (the image
+    /// upright when edge_u points right and edge_v up); None elsewhere.
+    pub uv: Option<Vec2>,
 }
 
 /// All of a scene's surfaces, ready for ray queries.
@@ -193,6 +204,8 @@ pub struct Geometry {
     /// None when there are few primitives: testing them all is faster.
     bvh: Option<Bvh4>,
     bounds: Option<(Vec3, Vec3)>,
+    /// The texture coordinates of the triangles that have them.
+    triangle_uvs: Vec<[Vec2; 3]>,
 }
 
 /// Up to this many primitives are tested one by one, without the BVH.
@@ -216,23 +229,32 @@ pub struct GeometryBuilder {
     records: Vec<Record>,
     planes: Vec<PlaneRecord>,
     unbounded: Vec<UnboundedSdf>,
+    triangle_uvs: Vec<[Vec2; 3]>,
 }
 
 impl GeometryBuilder {
     /// Adds a shape with a material index and, for area lights, the index of
     /// the light it is the surface of.
     pub fn add(&mut self, shape: &Shape, material: u32, emitter: Option<u32>) {
-        let mut push = |prim| self.records.push(Record { prim, material, emitter });
+        let mut push = |prim| self.records.push(Record { prim, material, emitter, uv: NO_UV });
         match shape {
             Shape::Sphere { center, radius } => push(Prim::Sphere { center: *center, radius: *radius }),
             Shape::Quad { corner, edge_u, edge_v } => {
                 push(Prim::Quad { corner: *corner, edge_u: *edge_u, edge_v: *edge_v })
             }
             Shape::Box { min, max } => push(Prim::Box { min: *min, max: *max }),
-            Shape::Mesh { positions, triangles } => {
+            Shape::Mesh { positions, triangles, uvs } => {
+                let textured = !uvs.is_empty() && uvs.len() == positions.len();
                 for tri in triangles {
                     let [a, b, c] = tri.map(|i| positions[i as usize]);
-                    push(Prim::Triangle { v0: a, e1: b - a, e2: c - a });
+                    let uv = if textured {
+                        self.triangle_uvs.push(tri.map(|i| uvs[i as usize]));
+                        self.triangle_uvs.len() as u32 - 1
+                    } else {
+                        NO_UV
+                    };
+                    let prim = Prim::Triangle { v0: a, e1: b - a, e2: c - a };
+                    self.records.push(Record { prim, material, emitter, uv });
                 }
             }
             Shape::Transformed { shape, world_from_local } => {
@@ -275,12 +297,12 @@ impl GeometryBuilder {
 
     /// Builds the BVH and lays the primitives out in its order.
     pub fn build(self) -> Geometry {
-        let GeometryBuilder { records, planes, unbounded } = self;
+        let GeometryBuilder { records, planes, unbounded, triangle_uvs } = self;
         let bounds = records.iter().map(|r| r.prim.bounds()).reduce(|a, b| a.union(&b));
         let bounds = bounds.map(|b| (Vec3::from(b.min), Vec3::from(b.max)));
         if records.len() <= LINEAR_LIMIT {
             let triangles = triangles_of(&records);
-            return Geometry { records, planes, unbounded, triangles, bvh: None, bounds };
+            return Geometry { records, planes, unbounded, triangles, bvh: None, bounds, triangle_uvs };
         }
         let mut params = BvhBuildParams::medium_build();
         if records.len() <= SMALL_SCENE {
@@ -301,9 +323,9 @@ impl GeometryBuilder {
         // can make the tree deeper than the traversal's fixed stack: such
         // scenes are searched linearly instead, slow but right.
         if bvh.depth() > bvh4::MAX_DEPTH {
-            return Geometry { records, planes, unbounded, triangles, bvh: None, bounds };
+            return Geometry { records, planes, unbounded, triangles, bvh: None, bounds, triangle_uvs };
         }
-        Geometry { records, planes, unbounded, triangles, bvh: Some(bvh), bounds }
+        Geometry { records, planes, unbounded, triangles, bvh: Some(bvh), bounds, triangle_uvs }
     }
 }
 
@@ -445,16 +467,48 @@ impl Geometry {
         let p = ray.at(hit.t);
         let index = hit.id as usize;
         match self.records.get(index) {
-            Some(rec) => SurfaceHit { p, n: rec.prim.normal(p), material: rec.material, emitter: rec.emitter },
+            Some(rec) => {
+                let uv = self.uv_at(rec, p);
+                SurfaceHit { p, n: rec.prim.normal(p), material: rec.material, emitter: rec.emitter, uv }
+            }
             None => match self.planes.get(index - self.records.len()) {
-                Some(plane) => SurfaceHit { p, n: plane.normal, material: plane.material, emitter: None },
+                Some(plane) => SurfaceHit { p, n: plane.normal, material: plane.material, emitter: None, uv: None },
                 None => {
                     let u = &self.unbounded[index - self.records.len() - self.planes.len()];
-                    SurfaceHit { p, n: u.sdf.normal(p), material: u.material, emitter: None }
+                    SurfaceHit { p, n: u.sdf.normal(p), material: u.material, emitter: None, uv: None }
                 }
             },
         }
     }
+
+    /// The texture coordinates at point `p` of a record (see [`SurfaceHit::uv`]).
+    fn uv_at(&self, rec: &Record, p: Vec3) -> Option<Vec2> {
+        match rec.prim {
+            Prim::Triangle { v0, e1, e2 } if rec.uv != NO_UV => {
+                let [b1, b2] = barycentric(p - v0, e1, e2);
+                let [t0, t1, t2] = self.triangle_uvs[rec.uv as usize];
+                Some(t0 + (t1 - t0) * b1 + (t2 - t0) * b2)
+            }
+            Prim::Quad { corner, edge_u, edge_v } => {
+                let [alpha, beta] = barycentric(p - corner, edge_u, edge_v);
+                Some(Vec2::new(alpha, 1.0 - beta))
+            }
+            _ => None,
+        }
+    }
+}
+
+/// The coordinates (a, b) of `rel = a·e1 + b·e2` for a point in the plane
+/// of `e1` and `e2`, by least squares (the 2×2 normal equations).
+#[inline]
+fn barycentric(rel: Vec3, e1: Vec3, e2: Vec3) -> [f32; 2] {
+    let (d11, d12, d22) = (e1.dot(e1), e1.dot(e2), e2.dot(e2));
+    let (r1, r2) = (rel.dot(e1), rel.dot(e2));
+    let det = d11 * d22 - d12 * d12;
+    if det == 0.0 {
+        return [0.0, 0.0];
+    }
+    [(d22 * r1 - d12 * r2) / det, (d11 * r2 - d12 * r1) / det]
 }
 
 #[inline]

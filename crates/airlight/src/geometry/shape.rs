@@ -4,7 +4,7 @@
 //! returns the smallest `t` in `(tmin, tmax)`, or `f32::INFINITY` on a miss, the
 //! convention of the BVH traversal.
 
-use glam::{Affine3A, Mat3, Vec3};
+use glam::{Affine3A, Mat3, Vec2, Vec3};
 
 /// A shape of the scene, in world space once built.
 #[derive(Clone, Debug, PartialEq)]
@@ -30,10 +30,13 @@ pub enum Shape {
         min: Vec3,
         max: Vec3,
     },
-    /// A triangle mesh; `indices` index `positions`.
+    /// A triangle mesh; `triangles` index `positions`, and `uvs` too when
+    /// the mesh has texture coordinates (one per position; empty when it
+    /// has none).
     Mesh {
         positions: Vec<Vec3>,
         triangles: Vec<[u32; 3]>,
+        uvs: Vec<Vec2>,
     },
     /// A signed distance field, sphere traced (see `geometry::sdf`).
     Sdf(super::sdf::Sdf),
@@ -79,8 +82,8 @@ impl Shape {
             Shape::Quad { corner, edge_u, edge_v } => {
                 Shape::Quad { corner: m.transform_point3(corner), edge_u: linear * edge_u, edge_v: linear * edge_v }
             }
-            Shape::Mesh { positions, triangles } => {
-                Shape::Mesh { positions: positions.iter().map(|&p| m.transform_point3(p)).collect(), triangles }
+            Shape::Mesh { positions, triangles, uvs } => {
+                Shape::Mesh { positions: positions.iter().map(|&p| m.transform_point3(p)).collect(), triangles, uvs }
             }
             Shape::Sphere { center, radius } if is_similarity(linear) => {
                 Shape::Sphere { center: m.transform_point3(center), radius: radius * linear.x_axis.length() }

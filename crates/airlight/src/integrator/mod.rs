@@ -44,6 +44,17 @@ pub trait Integrator: Send + Sync {
         false
     }
 
+    /// For the single-scattering integrators (raymarch, analytic,
+    /// stochastic): [`Integrator::radiance`] in its two parts, the first
+    /// surface's light as it reaches the camera (attenuated by the medium)
+    /// and the light the medium scatters toward the camera, drawn with the
+    /// same samples, so that their sum is `radiance` for the same sampler.
+    /// None for integrators that do not separate them.
+    fn radiance_parts(&self, scene: &Scene, ray: &Ray, sampler: &mut Sampler) -> Option<RadianceParts> {
+        let _ = (scene, ray, sampler);
+        None
+    }
+
     /// The scene's lights changed ([`Scene::set_lights`], [`Scene::at_time`]):
     /// update what was derived from them (radiosity relights its patches
     /// without recompiling; the analytic integrator re-places its emitters).
@@ -109,6 +120,22 @@ impl std::fmt::Display for IntegratorKind {
     }
 }
 
+/// Radiance along a camera ray in two parts (see [`Integrator::radiance_parts`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RadianceParts {
+    /// The first surface's radiance (or the background) times the
+    /// medium's transmittance to it.
+    pub surface: Rgb,
+    /// The light the medium scatters toward the ray's origin.
+    pub in_scattered: Rgb,
+}
+
+impl RadianceParts {
+    pub fn total(&self) -> Rgb {
+        self.surface + self.in_scattered
+    }
+}
+
 /// Radiance along `ray` as every single-scattering integrator sees it: the
 /// first surface (its emission and direct light, plus `extra`, e.g. the
 /// indirect light of a radiosity solution), attenuated by the scene's medium
@@ -126,8 +153,19 @@ pub fn single_scattering(
     extra: impl FnOnce(&SurfaceHit) -> Rgb,
     in_scattered: impl FnOnce(&Medium, f32, &mut Sampler) -> Rgb,
 ) -> Rgb {
+    single_scattering_parts(scene, ray, sampler, extra, in_scattered).total()
+}
+
+/// [`single_scattering`] in its two parts.
+pub fn single_scattering_parts(
+    scene: &Scene,
+    ray: &Ray,
+    sampler: &mut Sampler,
+    extra: impl FnOnce(&SurfaceHit) -> Rgb,
+    in_scattered: impl FnOnce(&Medium, f32, &mut Sampler) -> Rgb,
+) -> RadianceParts {
     let (surface, t_end) = first_surface(scene, ray, sampler, scene.medium(), extra);
-    through_medium(scene, ray, surface, t_end, sampler, in_scattered)
+    through_medium_parts(scene, ray, surface, t_end, sampler, in_scattered)
 }
 
 /// The second half of [`single_scattering`]: `surface` radiance from
@@ -141,12 +179,24 @@ pub fn through_medium(
     sampler: &mut Sampler,
     in_scattered: impl FnOnce(&Medium, f32, &mut Sampler) -> Rgb,
 ) -> Rgb {
+    through_medium_parts(scene, ray, surface, t_end, sampler, in_scattered).total()
+}
+
+/// [`through_medium`] in its two parts.
+pub fn through_medium_parts(
+    scene: &Scene,
+    ray: &Ray,
+    surface: Rgb,
+    t_end: f32,
+    sampler: &mut Sampler,
+    in_scattered: impl FnOnce(&Medium, f32, &mut Sampler) -> Rgb,
+) -> RadianceParts {
     let Some(medium) = scene.medium() else {
-        return surface;
+        return RadianceParts { surface, in_scattered: Rgb::ZERO };
     };
     let through = medium.transmittance(ray.origin, ray.dir, 0.0, t_end);
     let length = t_end.min(scene.settings().max_distance);
-    surface * through + in_scattered(medium, length, sampler)
+    RadianceParts { surface: surface * through, in_scattered: in_scattered(medium, length, sampler) }
 }
 
 /// The radiance leaving the first surface along `ray` toward its origin

@@ -3,7 +3,7 @@
 //! Single-Scattering" (2008): trace to the nearest surface, then
 //! sample the medium between eye and surface, a shadow ray from each sample.
 
-use super::{Integrator, RaymarchOptions, no_extra, single_scattering};
+use super::{Integrator, RadianceParts, RaymarchOptions, no_extra, single_scattering_parts};
 use crate::Rgb;
 use crate::geometry::Ray;
 use crate::medium::Medium;
@@ -40,7 +40,17 @@ impl Raymarch {
 
 impl Integrator for Raymarch {
     fn radiance(&self, scene: &Scene, ray: &Ray, sampler: &mut Sampler) -> Rgb {
-        single_scattering(scene, ray, sampler, no_extra, |medium, length, sampler| {
+        self.parts(scene, ray, sampler).total()
+    }
+
+    fn radiance_parts(&self, scene: &Scene, ray: &Ray, sampler: &mut Sampler) -> Option<RadianceParts> {
+        Some(self.parts(scene, ray, sampler))
+    }
+}
+
+impl Raymarch {
+    fn parts(&self, scene: &Scene, ray: &Ray, sampler: &mut Sampler) -> RadianceParts {
+        single_scattering_parts(scene, ray, sampler, no_extra, |medium, length, sampler| {
             march(scene, medium, ray, length, self.options, sampler)
         })
     }

@@ -31,7 +31,7 @@
 //! plane" facing the camera, whose radiance is `background`.
 
 use super::equiangular::Equiangular;
-use super::{Integrator, StochasticOptions, no_extra, single_scattering};
+use super::{Integrator, RadianceParts, StochasticOptions, no_extra, single_scattering_parts};
 use crate::Rgb;
 use crate::geometry::Ray;
 use crate::medium::Medium;
@@ -98,7 +98,17 @@ impl Integrator for Stochastic {
     }
 
     fn radiance(&self, scene: &Scene, ray: &Ray, sampler: &mut Sampler) -> Rgb {
-        single_scattering(scene, ray, sampler, no_extra, |medium, length, sampler| {
+        self.parts(scene, ray, sampler).total()
+    }
+
+    fn radiance_parts(&self, scene: &Scene, ray: &Ray, sampler: &mut Sampler) -> Option<RadianceParts> {
+        Some(self.parts(scene, ray, sampler))
+    }
+}
+
+impl Stochastic {
+    fn parts(&self, scene: &Scene, ray: &Ray, sampler: &mut Sampler) -> RadianceParts {
+        single_scattering_parts(scene, ray, sampler, no_extra, |medium, length, sampler| {
             self.in_scattered(scene, medium, ray, length, sampler)
         })
     }

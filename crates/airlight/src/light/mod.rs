@@ -352,6 +352,7 @@ impl Light {
             Light::Triangle { a, edge_1, edge_2, .. } => Some(crate::geometry::Shape::Mesh {
                 positions: vec![a, a + edge_1, a + edge_2],
                 triangles: vec![[0, 1, 2]],
+                uvs: Vec::new(),
             }),
             _ => None,
         }

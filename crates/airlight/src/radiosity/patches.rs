@@ -113,7 +113,7 @@ pub fn cut(
         }
         Shape::Box { min, max } => cut_box(*min, *max, h, inner, out),
         Shape::Sphere { center, radius } => cut_sphere(*center, *radius, h, inner, out),
-        Shape::Mesh { positions, triangles } => {
+        Shape::Mesh { positions, triangles, .. } => {
             for tri in triangles {
                 let [a, b, c] = tri.map(|i| positions[i as usize]);
                 cut_triangle(a, b, c, h, out);
@@ -154,7 +154,7 @@ pub fn count(shape: &Shape, h: f32, (center, half): (Vec3, f32)) -> f64 {
             let bands = cells(PI * radius, h).max(2) as f64;
             2.0 * bands * (cells(2.0 * PI * radius, h).max(3) as f64)
         }
-        Shape::Mesh { positions, triangles } => triangles
+        Shape::Mesh { positions, triangles, .. } => triangles
             .iter()
             .map(|t| {
                 let [a, b, c] = t.map(|i| positions[i as usize]);

@@ -53,6 +53,7 @@ pub fn build(desc: &SceneDesc, text: &str, assets: &AssetPath) -> Result<Scene, 
         files: RefCell::default(),
         mesh_bytes: Cell::new(0),
         notes: RefCell::default(),
+        textures: RefCell::default(),
     };
     let mut scene = checker.scene(desc)?;
     scene.files = checker.files.into_inner();
@@ -61,15 +62,17 @@ pub fn build(desc: &SceneDesc, text: &str, assets: &AssetPath) -> Result<Scene, 
 }
 
 pub(super) struct Checker<'a> {
-    text: &'a str,
+    pub(super) text: &'a str,
     pub(super) assets: &'a AssetPath,
-    document: toml::de::DeTable<'a>,
+    pub(super) document: toml::de::DeTable<'a>,
     /// The files read so far (meshes).
     pub(super) files: RefCell<Vec<PathBuf>>,
     /// Memory the meshes read so far will take.
     pub(super) mesh_bytes: Cell<u64>,
     /// What was asked for and is not done (see [`Scene::notes`]).
     pub(super) notes: RefCell<Vec<String>>,
+    /// Image files read as textures, so that each is read once.
+    pub(super) textures: RefCell<Vec<(PathBuf, std::sync::Arc<crate::texture::Texture>)>>,
 }
 
 pub(super) type Result<T, E = SceneError> = std::result::Result<T, E>;
@@ -261,44 +264,6 @@ impl Checker<'_> {
         Ok(())
     }
 
-    fn material(&self, name: &str, desc: &Spanned<MaterialDesc>) -> Result<Material> {
-        let span = desc.span();
-        let m = desc.get_ref();
-        let what = |field: &str| format!("materials.{name}.{field}");
-        let albedo = |t: Option<Triple>, field: &str, default: f32| -> Result<Rgb> {
-            self.non_negative3(span.clone(), &what(field), t.map_or(Vec3::splat(default), |t| t.0))
-        };
-        let misplaced = |present: bool, field: &str, owner: &str| -> Result<()> {
-            if present {
-                Err(self.err_field(span.clone(), field, format!("{} belongs to a {owner} material", what(field))))
-            } else {
-                Ok(())
-            }
-        };
-        if m.kind != MaterialType::Checker {
-            misplaced(m.albedo2.is_some(), "albedo2", "checker")?;
-            misplaced(m.scale.is_some(), "scale", "checker")?;
-        }
-        if m.kind != MaterialType::Phong {
-            misplaced(m.specular.is_some(), "specular", "phong")?;
-            misplaced(m.exponent.is_some(), "exponent", "phong")?;
-        }
-        let a = albedo(m.albedo, "albedo", 0.8)?;
-        Ok(match m.kind {
-            MaterialType::Diffuse => Material::diffuse(a),
-            MaterialType::Checker => {
-                let a2 = albedo(m.albedo2, "albedo2", 0.2)?;
-                let scale = self.positive(span, &what("scale"), m.scale.unwrap_or(1.0))?;
-                Material::checker(a, a2, scale)
-            }
-            MaterialType::Phong => {
-                let specular = albedo(m.specular, "specular", 0.04)?;
-                let exponent = self.non_negative(span, &what("exponent"), m.exponent.unwrap_or(32.0))?;
-                Material::phong(a, specular, exponent)
-            }
-        })
-    }
-
     fn object(&self, index: usize, desc: &Spanned<ObjectDesc>, scene: &SceneDesc) -> Result<Built> {
         let span = desc.span();
         let o = desc.get_ref();
@@ -435,21 +400,12 @@ impl Checker<'_> {
                 }
                 None => self.mesh_with_materials(span, &label, &d.file, transform)?,
             };
-            return Ok(gltf::Imported { built, camera: None, textures_skipped: 0 });
+            return Ok(gltf::Imported { built, camera: None });
         }
         if !(file.ends_with(".gltf") || file.ends_with(".glb")) {
             return Err(self.err(d.file.span(), format!("{label}: `file` must be a .gltf, .glb or .obj file")));
         }
-        let imported =
-            self.gltf(&gltf::Include { label: &label, file: &d.file, scene: d.scene.as_deref(), transform, material })?;
-        if imported.textures_skipped > 0 {
-            self.notes.borrow_mut().push(format!(
-                "{label}: {} primitives have a base-colour texture, which Airlight does not read yet; \
-                 they take their base colour factor",
-                imported.textures_skipped
-            ));
-        }
-        Ok(imported)
+        self.gltf(&gltf::Include { label: &label, file: &d.file, scene: d.scene.as_deref(), transform, material })
     }
 
     /// A mesh object without a `material`: its faces take the `.mtl`
@@ -466,6 +422,7 @@ impl Checker<'_> {
         let only_part = parts.len() == 1;
         let mut built = Built::default();
         for part in parts {
+            let texture = part.texture;
             let Some(m) = part.material else {
                 let why = if only_part {
                     "(a name from [materials]), or faces with `usemtl` materials from an `mtllib`"
@@ -481,7 +438,12 @@ impl Checker<'_> {
                 }
                 _ => {
                     let name = format!("{}:{}", file.get_ref(), m.name);
-                    built.materials.push((name.clone(), Material::diffuse(m.diffuse.unwrap_or(Vec3::splat(0.8)))));
+                    let material = match texture {
+                        // The MTL convention: the map scaled by Kd (1 when absent).
+                        Some(t) => Material::textured(m.diffuse.unwrap_or(Vec3::ONE), t),
+                        None => Material::diffuse(m.diffuse.unwrap_or(Vec3::splat(0.8))),
+                    };
+                    built.materials.push((name.clone(), material));
                     built.objects.push((placed, name));
                 }
             }
@@ -497,7 +459,7 @@ impl Checker<'_> {
             Shape::Sphere { center, radius } => Ok(vec![Light::sphere(center, radius, radiance)]),
             Shape::Quad { corner, edge_u, edge_v } => Ok(vec![Light::quad(corner, edge_u, edge_v, radiance)]),
             // The mesh's memory was checked when it was read.
-            Shape::Mesh { positions, triangles } => Ok(Light::triangles_of(&positions, &triangles, radiance)),
+            Shape::Mesh { positions, triangles, .. } => Ok(Light::triangles_of(&positions, &triangles, radiance)),
             _ => Err(self.err_field(
                 span,
                 "emission",

@@ -154,6 +154,7 @@ pub enum MaterialType {
     Diffuse,
     Checker,
     Phong,
+    Texture,
 }
 
 #[derive(Debug, Deserialize)]
@@ -166,6 +167,10 @@ pub struct MaterialDesc {
     pub scale: Option<f32>,
     pub specular: Option<Triple>,
     pub exponent: Option<f32>,
+    /// texture: the image file (PNG or JPEG), under the asset rules.
+    pub file: Option<Spanned<String>>,
+    /// texture: `repeat`, `clamp` or `mirror`.
+    pub wrap: Option<Spanned<String>>,
 }
 
 fn diffuse() -> MaterialType {

@@ -1,6 +1,6 @@
 //! glTF 2.0 scenes (`.gltf` with its buffers, or `.glb`), read with the
 //! `gltf` crate: the node hierarchy with its transforms, triangle meshes,
-//! `KHR_lights_punctual` lights, materials' base colour and emission
+//! `KHR_lights_punctual` lights, materials' base colour (factor × texture) and emission
 //! (`KHR_materials_emissive_strength`), and the first camera. What Airlight
 //! makes of each is in docs/scene-format.md ("glTF scenes").
 //!
@@ -16,9 +16,12 @@ use crate::camera::Camera;
 use crate::geometry::Shape;
 use crate::light::{Attenuation, Light, SpotProfile};
 use crate::material::Material;
+use crate::texture::{Texture, Wrap};
 use base64::Engine;
-use glam::{Affine3A, Mat4, Vec3};
+use glam::{Affine3A, Mat4, Vec2, Vec3};
+use std::collections::HashMap;
 use std::path::Path;
+use std::sync::Arc;
 use toml::Spanned;
 
 /// Luminous efficacy used to turn glTF's photometric light units into
@@ -36,8 +39,6 @@ pub(super) struct Imported {
     pub built: Built,
     /// The first camera met, with its aspect ratio when the file gives one.
     pub camera: Option<(Camera, Option<f32>)>,
-    /// Base-colour textures the file has that were not read.
-    pub textures_skipped: usize,
 }
 
 /// What is being imported and how: the include's label, file, scene name,
@@ -84,7 +85,8 @@ impl Checker<'_> {
             .map_err(|e| fail(e.to_string()))?;
         self.mesh_bytes.set(needed);
 
-        let mut out = Imported { built: Built::default(), camera: None, textures_skipped: 0 };
+        let mut out = Imported { built: Built::default(), camera: None };
+        let mut textures = Textures { file: Path::new(name), buffers: &buffers, read: HashMap::new() };
         let mut stack: Vec<(gltf::Node, Affine3A, usize)> =
             scene.nodes().map(|n| (n, include.transform, 0)).collect::<Vec<_>>();
         stack.reverse();
@@ -99,7 +101,7 @@ impl Checker<'_> {
             }
             let world = parent * Affine3A::from_mat4(local);
             if let Some(mesh) = node.mesh() {
-                self.gltf_mesh(include, &mesh, world, &buffers, &mut out).map_err(&fail)?;
+                self.gltf_mesh(include, &mesh, world, &mut textures, &mut out).map_err(&fail)?;
             }
             if let Some(light) = node.light() {
                 out.built.lights.push(gltf_light(&light, world).map_err(|why| fail(format!("{at}: {why}")))?);
@@ -152,9 +154,10 @@ impl Checker<'_> {
         include: &Include,
         mesh: &gltf::Mesh,
         world: Affine3A,
-        buffers: &[Vec<u8>],
+        textures: &mut Textures,
         out: &mut Imported,
     ) -> std::result::Result<(), String> {
+        let buffers = textures.buffers;
         // A mirroring transform turns counter-clockwise front faces clockwise.
         let mirrored = world.matrix3.determinant() < 0.0;
         for primitive in mesh.primitives() {
@@ -192,9 +195,6 @@ impl Checker<'_> {
                 continue;
             }
             let material = primitive.material();
-            if material.pbr_metallic_roughness().base_color_texture().is_some() {
-                out.textures_skipped += 1;
-            }
             let strength = material.emissive_strength().unwrap_or(1.0);
             let emission = Vec3::from_array(material.emissive_factor()) * strength;
             if !(emission.is_finite() && emission.min_element() >= 0.0) {
@@ -204,6 +204,8 @@ impl Checker<'_> {
                 out.built.lights.extend(Light::triangles_of(&positions, &triangles, emission));
                 continue;
             }
+            let base_colour = material.pbr_metallic_roughness().base_color_texture();
+            let mut uvs = Vec::new();
             let name = match include.material {
                 Some(name) => name.to_string(),
                 None => {
@@ -212,20 +214,146 @@ impl Checker<'_> {
                         Some(i) => format!("{}#materials[{i}]", include.file.get_ref()),
                         None => format!("{}#default", include.file.get_ref()),
                     };
+                    if let Some(info) = &base_colour {
+                        uvs = texture_coordinates(&primitive, info.tex_coord(), positions.len(), buffers)
+                            .map_err(|why| format!("{at}: {why}"))?;
+                    }
                     if !out.built.materials.iter().any(|(n, _)| *n == name) {
                         let albedo = Vec3::new(r, g, b);
                         if !(albedo.is_finite() && albedo.min_element() >= 0.0) {
                             return Err(format!("{at}: its base colour is not finite and ≥ 0: {albedo}"));
                         }
-                        out.built.materials.push((name.clone(), Material::diffuse(albedo)));
+                        let m = match &base_colour {
+                            Some(info) => {
+                                let i = material.index().unwrap_or(0);
+                                let texture = self.gltf_texture(textures, &info.texture()).map_err(|why| {
+                                    format!("materials[{i}].pbrMetallicRoughness.baseColorTexture: {why}")
+                                })?;
+                                Material::textured(albedo, texture)
+                            }
+                            None => Material::diffuse(albedo),
+                        };
+                        out.built.materials.push((name.clone(), m));
                     }
                     name
                 }
             };
-            out.built.objects.push((Shape::Mesh { positions, triangles }, name));
+            out.built.objects.push((Shape::Mesh { positions, triangles, uvs }, name));
         }
         Ok(())
     }
+}
+
+/// The glTF file's images, read once each, and what they are read from.
+struct Textures<'a> {
+    /// The glTF file's name in the scene (images in files lie beside it).
+    file: &'a Path,
+    buffers: &'a [Vec<u8>],
+    /// By texture index: an image with its sampler's wrap modes.
+    read: HashMap<usize, Arc<Texture>>,
+}
+
+impl Checker<'_> {
+    /// A glTF texture: its image (a file beside the glTF file under the
+    /// asset rules, a data URI, or a buffer view), decoded to sRGB texels,
+    /// with its sampler's wrap modes; read once per texture.
+    fn gltf_texture(
+        &self,
+        textures: &mut Textures,
+        texture: &gltf::Texture,
+    ) -> std::result::Result<Arc<Texture>, String> {
+        if let Some(t) = textures.read.get(&texture.index()) {
+            return Ok(t.clone());
+        }
+        let image = texture.source();
+        let at = format!("textures[{}] → images[{}]", texture.index(), image.index());
+        let bytes: Vec<u8> = match image.source() {
+            gltf::image::Source::View { view, .. } => {
+                let buffer = textures.buffers.get(view.buffer().index()).map_or(&[][..], Vec::as_slice);
+                let range = view.offset()..view.offset().saturating_add(view.length());
+                buffer
+                    .get(range)
+                    .ok_or_else(|| format!("{at}: bufferViews[{}] runs past the end of its buffer", view.index()))?
+                    .to_vec()
+            }
+            gltf::image::Source::Uri { uri, .. } if uri.starts_with("data:") => {
+                let (_, encoded) =
+                    uri.split_once(";base64,").ok_or_else(|| format!("{at}: a data URI that is not base64"))?;
+                base64::engine::general_purpose::STANDARD
+                    .decode(encoded)
+                    .map_err(|e| format!("{at}: its data URI is not valid base64: {e}"))?
+            }
+            gltf::image::Source::Uri { uri, .. } => {
+                let uri = percent_decoded(uri);
+                let beside = textures.file.parent().unwrap_or(Path::new("")).join(&uri);
+                let path = self.assets.resolve(&beside.to_string_lossy()).map_err(|why| format!("{at}: {why}"))?;
+                let data = read_limited(&path, MAX_MESH_BYTES).map_err(|why| format!("{at}: `{uri}`: {why}"))?;
+                self.files.borrow_mut().push(path);
+                data
+            }
+        };
+        let decoded = self.texture_bytes(&bytes, &at).map_err(|why| format!("{at}: {why}"))?;
+        let sampler = texture.sampler();
+        let texture_arc = Arc::new(decoded.with_wrap(wrap(sampler.wrap_s()), wrap(sampler.wrap_t())));
+        textures.read.insert(texture.index(), texture_arc.clone());
+        Ok(texture_arc)
+    }
+}
+
+fn wrap(mode: gltf::texture::WrappingMode) -> Wrap {
+    match mode {
+        gltf::texture::WrappingMode::Repeat => Wrap::Repeat,
+        gltf::texture::WrappingMode::ClampToEdge => Wrap::ClampToEdge,
+        gltf::texture::WrappingMode::MirroredRepeat => Wrap::MirroredRepeat,
+    }
+}
+
+/// A URI's `%XX` escapes decoded (glTF URIs are escaped: `my%20wood.png`).
+fn percent_decoded(uri: &str) -> String {
+    let bytes = uri.as_bytes();
+    let mut out = Vec::with_capacity(bytes.len());
+    let mut i = 0;
+    while i < bytes.len() {
+        let hex = |b: u8| (b as char).to_digit(16);
+        if bytes[i] == b'%'
+            && let (Some(hi), Some(lo)) =
+                (bytes.get(i + 1).and_then(|&b| hex(b)), bytes.get(i + 2).and_then(|&b| hex(b)))
+        {
+            out.push((hi * 16 + lo) as u8);
+            i += 3;
+        } else {
+            out.push(bytes[i]);
+            i += 1;
+        }
+    }
+    String::from_utf8_lossy(&out).into_owned()
+}
+
+/// A primitive's `TEXCOORD_<set>`, one per vertex, finite.
+fn texture_coordinates(
+    primitive: &gltf::Primitive,
+    set: u32,
+    vertices: usize,
+    buffers: &[Vec<u8>],
+) -> std::result::Result<Vec<Vec2>, String> {
+    let accessor = primitive
+        .get(&gltf::Semantic::TexCoords(set))
+        .ok_or_else(|| format!("its material's base-colour texture uses TEXCOORD_{set}, which it does not have"))?;
+    fits(&accessor, buffers).map_err(|why| format!("TEXCOORD_{set}: {why}"))?;
+    let reader = primitive.reader(|b| buffers.get(b.index()).map(Vec::as_slice));
+    let uvs: Vec<Vec2> = reader
+        .read_tex_coords(set)
+        .ok_or_else(|| format!("TEXCOORD_{set} cannot be read"))?
+        .into_f32()
+        .map(Vec2::from_array)
+        .collect();
+    if uvs.len() != vertices {
+        return Err(format!("TEXCOORD_{set} has {} elements for {vertices} vertices", uvs.len()));
+    }
+    if let Some(uv) = uvs.iter().find(|uv| !uv.is_finite()) {
+        return Err(format!("TEXCOORD_{set}: a coordinate is not finite: {uv}"));
+    }
+    Ok(uvs)
 }
 
 /// Whether an accessor's bytes lie inside its buffer view and the view

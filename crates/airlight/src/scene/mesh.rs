@@ -9,9 +9,10 @@ use super::build::{Checker, Result};
 use super::mtl::{self, MtlMaterial};
 use super::obj::{self, Obj};
 use crate::geometry::Shape;
-use glam::Vec3;
+use crate::texture::Texture;
 use std::collections::HashMap;
 use std::path::Path;
+use std::sync::Arc;
 use toml::Spanned;
 
 /// Largest `.mtl` file read.
@@ -22,13 +23,19 @@ const MAX_MTL_BYTES: u64 = 64 << 20;
 pub(super) struct MeshPart {
     pub shape: Shape,
     pub material: Option<MtlMaterial>,
+    /// Its material's `map_Kd`, read.
+    pub texture: Option<Arc<Texture>>,
 }
 
 impl Checker<'_> {
-    /// The mesh, all of it, its materials unread.
+    /// The mesh, all of it, with its texture coordinates if every face
+    /// has them; its materials unread.
     pub(super) fn mesh(&self, label: &str, file: &Spanned<String>) -> Result<Shape> {
         let obj = self.load_obj(label, file)?;
-        Ok(Shape::Mesh { positions: obj.positions, triangles: obj.triangles })
+        if obj.triangle_texcoords.is_empty() {
+            return Ok(Shape::Mesh { positions: obj.positions, triangles: obj.triangles, uvs: Vec::new() });
+        }
+        Ok(compact(&obj, 0..obj.triangles.len(), true))
     }
 
     /// The mesh cut into one part per `.mtl` material its faces use, the
@@ -41,23 +48,31 @@ impl Checker<'_> {
             self.err(file.span(), format!("{label}: cannot load mesh {}:{line}: {why}", path.display()))
         };
         let mut library: Vec<MtlMaterial> = Vec::new();
+        let mut library_of: HashMap<String, std::path::PathBuf> = HashMap::new();
         for (name, line) in &obj.libraries {
             let beside = path.parent().unwrap_or(Path::new("")).join(name);
             let mtl_path = self.assets.resolve(&beside.to_string_lossy()).map_err(|why| fail_at(*line, why))?;
             let bytes =
                 read_limited(&mtl_path, MAX_MTL_BYTES).map_err(|why| fail_at(*line, format!("{name}: {why}")))?;
             let text = String::from_utf8_lossy(&bytes);
-            let materials = mtl::parse(&text).map_err(|e| {
+            let mut materials = mtl::parse(&text).map_err(|e| {
                 self.err(
                     file.span(),
                     format!("{label}: cannot load material library {}:{}: {}", mtl_path.display(), e.line, e.message),
                 )
             })?;
-            self.files.borrow_mut().push(mtl_path);
+            self.files.borrow_mut().push(mtl_path.clone());
+            // Texture maps are named relative to their library.
+            for m in &mut materials {
+                if let Some((map, _)) = &mut m.diffuse_map {
+                    *map = beside.parent().unwrap_or(Path::new("")).join(&*map).to_string_lossy().into_owned();
+                }
+            }
+            library_of.extend(materials.iter().map(|m| (m.name.clone(), mtl_path.clone())));
             library.extend(materials);
         }
         // Triangles grouped by material, in order of first use.
-        let mut groups: Vec<(Option<MtlMaterial>, Vec<[u32; 3]>)> = Vec::new();
+        let mut groups: Vec<(Option<MtlMaterial>, Vec<usize>)> = Vec::new();
         let mut group_of: HashMap<Option<String>, usize> = HashMap::new();
         let runs = &obj.material_runs;
         for (i, (start, used)) in runs.iter().enumerate() {
@@ -75,17 +90,35 @@ impl Checker<'_> {
                 groups.push((material, Vec::new()));
                 groups.len() - 1
             });
-            groups[index].1.extend_from_slice(&obj.triangles[*start..end]);
+            groups[index].1.extend(*start..end);
         }
-        if let [(material, _)] = &mut groups[..] {
+        // Texture coordinates only where a texture will use them.
+        let textured = |m: &Option<MtlMaterial>| {
+            !obj.triangle_texcoords.is_empty() && m.as_ref().is_some_and(|m| m.diffuse_map.is_some())
+        };
+        let texture_of = |m: &Option<MtlMaterial>| -> Result<Option<Arc<Texture>>> {
+            let Some((m, (map, line))) = m.as_ref().and_then(|m| Some(m).zip(m.diffuse_map.as_ref())) else {
+                return Ok(None);
+            };
+            self.texture_file(map).map(Some).map_err(|why| {
+                let mtl = library_of.get(&m.name).map_or(String::new(), |p| p.display().to_string());
+                self.err(file.span(), format!("{label}: cannot load material library {mtl}:{line}: map_Kd: {why}"))
+            })
+        };
+        if let [(material, _)] = &mut groups[..]
+            && !textured(material)
+        {
             // One material: the mesh as read.
-            let shape = Shape::Mesh { positions: obj.positions, triangles: obj.triangles };
-            return Ok(vec![MeshPart { shape, material: material.take() }]);
+            let texture = texture_of(material)?;
+            let shape = Shape::Mesh { positions: obj.positions, triangles: obj.triangles, uvs: Vec::new() };
+            return Ok(vec![MeshPart { shape, material: material.take(), texture }]);
         }
-        Ok(groups
-            .into_iter()
-            .map(|(material, triangles)| MeshPart { shape: compact(&obj.positions, triangles), material })
-            .collect())
+        let mut parts = Vec::new();
+        for (material, triangles) in groups {
+            let shape = compact(&obj, triangles.into_iter(), textured(&material));
+            parts.push(MeshPart { shape, texture: texture_of(&material)?, material });
+        }
+        Ok(parts)
     }
 
     fn load_obj(&self, label: &str, file: &Spanned<String>) -> Result<Obj> {
@@ -115,20 +148,26 @@ impl Checker<'_> {
     }
 }
 
-/// A mesh of `triangles` holding only the vertices they use.
-fn compact(positions: &[Vec3], triangles: Vec<[u32; 3]>) -> Shape {
-    let mut index: HashMap<u32, u32> = HashMap::new();
-    let mut kept = Vec::new();
+/// A mesh of the OBJ's triangles numbered `triangles`, holding only the
+/// vertices they use; with texture coordinates, a vertex for each pair of
+/// position and `vt` (OBJ indexes them apart, Airlight's meshes together).
+fn compact(obj: &Obj, triangles: impl Iterator<Item = usize>, with_texcoords: bool) -> Shape {
+    let mut index: HashMap<(u32, u32), u32> = HashMap::new();
+    let (mut positions, mut uvs) = (Vec::new(), Vec::new());
     let triangles = triangles
-        .into_iter()
         .map(|t| {
-            t.map(|i| {
-                *index.entry(i).or_insert_with(|| {
-                    kept.push(positions[i as usize]);
-                    kept.len() as u32 - 1
+            let corners = obj.triangles[t];
+            std::array::from_fn(|k| {
+                let vt = if with_texcoords { obj.triangle_texcoords[t][k] } else { u32::MAX };
+                *index.entry((corners[k], vt)).or_insert_with(|| {
+                    positions.push(obj.positions[corners[k] as usize]);
+                    if with_texcoords {
+                        uvs.push(obj.texcoords[vt as usize]);
+                    }
+                    positions.len() as u32 - 1
                 })
             })
         })
         .collect();
-    Shape::Mesh { positions: kept, triangles }
+    Shape::Mesh { positions, triangles, uvs }
 }

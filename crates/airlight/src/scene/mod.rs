@@ -12,6 +12,7 @@ pub mod assets;
 mod build;
 mod build_camera;
 mod build_lights;
+mod build_materials;
 mod build_medium;
 pub mod desc;
 mod error;
@@ -22,10 +23,12 @@ mod mesh;
 mod mtl;
 pub mod obj;
 mod sdf;
+mod texture_file;
 mod warnings;
 
 pub use assets::AssetPath;
 pub use build::{build, parse};
+pub use build_materials::medium_from_options;
 pub use desc::SceneDesc;
 pub use error::{SceneError, line_col};
 pub use lights::LightCulling;
@@ -210,10 +213,11 @@ impl Scene {
         self.materials.get(index as usize).unwrap_or(&Material::BLACK)
     }
 
-    /// The material at a hit.
+    /// The material at a hit, a texture looked up at its texture
+    /// coordinates ([`Material::at_uv`]).
     #[inline]
-    pub fn material_at(&self, surface: &SurfaceHit) -> &Material {
-        self.material(surface.material)
+    pub fn material_at(&self, surface: &SurfaceHit) -> Material {
+        self.material(surface.material).at_uv(surface.uv)
     }
 
     pub fn lights(&self) -> &[Light] {
@@ -228,6 +232,12 @@ impl Scene {
     /// The participating medium, if there is one that absorbs or scatters.
     pub fn medium(&self) -> Option<&Medium> {
         self.medium.as_ref()
+    }
+
+    /// Replaces the medium (None, or a vacuum: no medium). Integrators
+    /// built for the scene before must be built again.
+    pub fn set_medium(&mut self, medium: Option<Medium>) {
+        self.medium = medium.filter(|m| !m.is_vacuum());
     }
 
     pub fn geometry(&self) -> &Geometry {

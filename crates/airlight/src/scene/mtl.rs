@@ -1,8 +1,9 @@
 //! Wavefront MTL material libraries, as far as Airlight's materials go: a
 //! material (`newmtl NAME`) gives its diffuse colour `Kd` (the albedo) and
 //! its emitted colour `Ke` (radiance, W/(m²·sr)); everything else (`Ka`,
-//! `Ks`, `Ns`, `d`, `illum`, texture maps) is skipped. A `map_Kd` texture
-//! is noted so that the caller can say it is not used.
+//! `Ks`, `Ns`, `d`, `illum`, other texture maps) is skipped. A `map_Kd`
+//! names a diffuse texture (its options, such as `-bm 1`, are skipped; the
+//! file name is the last word), which the caller reads.
 
 use super::obj::ObjError;
 use glam::Vec3;
@@ -15,8 +16,8 @@ pub struct MtlMaterial {
     pub line: usize,
     pub diffuse: Option<Vec3>,
     pub emission: Option<Vec3>,
-    /// A `map_Kd` texture it names (not read).
-    pub diffuse_map: Option<String>,
+    /// The `map_Kd` texture it names, with the line that names it.
+    pub diffuse_map: Option<(String, usize)>,
 }
 
 /// The materials of a library, in file order.
@@ -41,7 +42,11 @@ pub fn parse(text: &str) -> Result<Vec<MtlMaterial>, ObjError> {
             return Err(ObjError { line: n, message: format!("{keyword} before any newmtl") });
         };
         match keyword {
-            "map_Kd" => material.diffuse_map = words.last().map(str::to_string),
+            "map_Kd" => {
+                let file =
+                    words.last().ok_or_else(|| ObjError { line: n, message: "map_Kd needs a file name".into() })?;
+                material.diffuse_map = Some((file.to_string(), n));
+            }
             _ => {
                 let colour = colour(keyword, words).map_err(|message| ObjError { line: n, message })?;
                 if keyword == "Kd" {
@@ -91,7 +96,7 @@ mod tests {
         assert_eq!(m[1].name, "lamp shade");
         assert_eq!(m[1].emission, Some(Vec3::splat(10.0)));
         assert_eq!(m[1].diffuse, Some(Vec3::ZERO));
-        assert_eq!(m[1].diffuse_map.as_deref(), Some("tex/lamp.png"));
+        assert_eq!(m[1].diffuse_map, Some(("tex/lamp.png".to_string(), 10)));
     }
 
     #[test]
@@ -103,6 +108,7 @@ mod tests {
             ("newmtl a\n\nKe 1 1\n", 3, "Ke needs three numbers (r g b), got 2"),
             ("newmtl a\nKd -1 0 0\n", 2, "Kd must be finite and ≥ 0, got [-1, 0, 0]"),
             ("newmtl a\nKd spectral x.spd\n", 2, "Kd spectral: only r g b colours are read"),
+            ("newmtl a\nmap_Kd\n", 2, "map_Kd needs a file name"),
         ];
         for (text, line, message) in cases {
             assert_eq!(parse(text), Err(ObjError { line, message: message.into() }), "{text:?}");

@@ -3,14 +3,16 @@
 //! with each following pair), and the names of the material libraries
 //! (`mtllib`) and materials (`usemtl`) the faces use; the libraries are
 //! opened by the caller, only when the scene asks for them (mtl.rs).
-//! Everything else (texture coordinates, normals, groups) is skipped.
+//! Texture coordinates (`vt`) are read with the faces' `v/vt` pairs, v
+//! flipped to Airlight's top-down convention (see [`crate::texture`]).
+//! Everything else (normals, groups) is skipped.
 //!
 //! Indices count from 1, or back from the latest vertex when negative, and
 //! may refer to vertices defined later in the file. Errors name the line.
 //! The file is counted before it is read, so that the memory a mesh needs
 //! is known (and refused when too much) before it is allocated.
 
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 
 /// Bytes a triangle costs once built (its indices, its share of the BVH and
 /// of the vertices), for the up-front memory estimate.
@@ -27,6 +29,11 @@ pub struct Obj {
     /// run and the material's name with its line (None before any
     /// `usemtl`); a run lasts until the next one starts.
     pub material_runs: Vec<(usize, Option<(String, usize)>)>,
+    /// `vt` coordinates as (u, 1 − v).
+    pub texcoords: Vec<Vec2>,
+    /// For each triangle, the `vt` of its corners; empty unless every face
+    /// gives one for every vertex.
+    pub triangle_texcoords: Vec<[u32; 3]>,
 }
 
 /// What is wrong, and on which line (1-based; 0 for the file as a whole).
@@ -77,7 +84,10 @@ pub fn parse(bytes: &[u8], vertices: u64, triangles: u64) -> Result<Obj, ObjErro
     obj.triangles.try_reserve_exact(triangles as usize).map_err(|_| refused(triangles, "triangles", 12))?;
     // The largest index met, and where: checked once every vertex is known.
     let mut highest: Option<(u32, usize)> = None;
+    let mut highest_texcoord: Option<(u32, usize)> = None;
+    let mut every_face_textured = true;
     let mut face: Vec<u32> = Vec::new();
+    let mut face_texcoords: Vec<u32> = Vec::new();
     for (n, line) in lines(bytes) {
         let (keyword, mut words) = statement(line);
         match keyword {
@@ -101,8 +111,26 @@ pub fn parse(bytes: &[u8], vertices: u64, triangles: u64) -> Result<Obj, ObjErro
                 }
                 obj.positions.push(p);
             }
+            b"vt" => {
+                let mut uv = [0.0f32; 2];
+                for (k, x) in uv.iter_mut().enumerate() {
+                    // v may be left out (1-D textures): 0.
+                    let Some(word) = words.next() else {
+                        if k == 1 {
+                            break;
+                        }
+                        return fail(n, "texture coordinates need a number: vt u [v]");
+                    };
+                    *x = number(word).filter(|x| x.is_finite()).ok_or_else(|| ObjError {
+                        line: n,
+                        message: format!("`{}` is not a finite number", String::from_utf8_lossy(word)),
+                    })?;
+                }
+                obj.texcoords.push(Vec2::new(uv[0], 1.0 - uv[1]));
+            }
             b"f" => {
                 face.clear();
+                face_texcoords.clear();
                 for word in words {
                     let index =
                         vertex_index(word, obj.positions.len()).map_err(|m| ObjError { line: n, message: m })?;
@@ -110,6 +138,15 @@ pub fn parse(bytes: &[u8], vertices: u64, triangles: u64) -> Result<Obj, ObjErro
                         highest = Some((index, n));
                     }
                     face.push(index);
+                    match texcoord_index(word, obj.texcoords.len()).map_err(|m| ObjError { line: n, message: m })? {
+                        Some(t) => {
+                            if highest_texcoord.is_none_or(|(h, _)| t > h) {
+                                highest_texcoord = Some((t, n));
+                            }
+                            face_texcoords.push(t);
+                        }
+                        None => every_face_textured = false,
+                    }
                 }
                 if face.len() < 3 {
                     return fail(n, format!("a face needs at least 3 vertices, got {}", face.len()));
@@ -119,6 +156,11 @@ pub fn parse(bytes: &[u8], vertices: u64, triangles: u64) -> Result<Obj, ObjErro
                 }
                 for pair in face[1..].windows(2) {
                     obj.triangles.push([face[0], pair[0], pair[1]]);
+                }
+                if every_face_textured {
+                    for pair in face_texcoords[1..].windows(2) {
+                        obj.triangle_texcoords.push([face_texcoords[0], pair[0], pair[1]]);
+                    }
                 }
             }
             b"usemtl" => {
@@ -149,6 +191,20 @@ pub fn parse(bytes: &[u8], vertices: u64, triangles: u64) -> Result<Obj, ObjErro
     if obj.triangles.is_empty() {
         return fail(0, "it holds no faces");
     }
+    if !every_face_textured {
+        obj.triangle_texcoords = Vec::new();
+    } else if let Some((index, line)) = highest_texcoord
+        && index as usize >= obj.texcoords.len()
+    {
+        return fail(
+            line,
+            format!(
+                "a face refers to texture coordinates {}, but the file has {}",
+                index as u64 + 1,
+                obj.texcoords.len()
+            ),
+        );
+    }
     Ok(obj)
 }
 
@@ -173,6 +229,27 @@ fn vertex_index(word: &[u8], defined: usize) -> Result<u32, String> {
     u32::try_from(index).map_err(|_| format!("vertex index {i} is beyond the {} vertices a mesh may have", u32::MAX))
 }
 
+/// The 0-based `vt` of a face word (`7/2`, `7/2/3`, `7/-1`), None when it
+/// gives none (`7`, `7//3`).
+fn texcoord_index(word: &[u8], defined: usize) -> Result<Option<u32>, String> {
+    let Some(second) = word.split(|&b| b == b'/').nth(1).filter(|w| !w.is_empty()) else {
+        return Ok(None);
+    };
+    let text = String::from_utf8_lossy(second);
+    let i: i64 = text
+        .parse()
+        .map_err(|_| format!("`{}`: `{text}` is not a texture coordinate index", String::from_utf8_lossy(word)))?;
+    let index = match i {
+        0 => return Err("texture coordinate index 0: OBJ counts from 1".into()),
+        i if i > 0 => i - 1,
+        i => defined as i64 + i,
+    };
+    if index < 0 {
+        return Err(format!("texture coordinate index {i} reaches back before the first ({defined} defined so far)"));
+    }
+    u32::try_from(index).map(Some).map_err(|_| format!("texture coordinate index {i} is too large"))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -191,9 +268,29 @@ mod tests {
         assert_eq!(obj.triangles, vec![[0, 1, 2], [0, 2, 3]]);
         assert_eq!(obj.libraries, vec![("evil.mtl".to_string(), 2)]);
         assert_eq!(obj.material_runs, vec![(0, None)]);
+        // Not every vertex gives a `vt`: no texture coordinates.
+        assert!(obj.triangle_texcoords.is_empty());
         assert_eq!(count(b"v 0 0 0\r\nf 1 1 1 1 1\n"), (1, 3));
         // A forward reference is allowed; \r\n line ends too.
         assert_eq!(read("f 1 2 3\r\nv 0 0 0\r\nv 1 0 0\r\nv 0 1 0\r\n").unwrap().triangles, vec![[0, 1, 2]]);
+    }
+
+    #[test]
+    fn texture_coordinates_follow_the_faces_with_v_flipped() {
+        let obj =
+            read("v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0.25\nf 1/1 2/2 3/3 4/-1\n").unwrap();
+        assert_eq!(
+            obj.texcoords,
+            vec![Vec2::new(0.0, 1.0), Vec2::new(1.0, 1.0), Vec2::new(1.0, 0.0), Vec2::new(0.25, 1.0)]
+        );
+        assert_eq!(obj.triangle_texcoords, vec![[0, 1, 2], [0, 2, 3]]);
+        let e = read("v 0 0 0\nvt 0 0\nf 1/1 1/2 1/1\n").unwrap_err();
+        assert_eq!(
+            e,
+            ObjError { line: 3, message: "a face refers to texture coordinates 2, but the file has 1".into() }
+        );
+        let e = read("v 0 0 0\nvt 0 nan\n").unwrap_err();
+        assert_eq!(e, ObjError { line: 2, message: "`nan` is not a finite number".into() });
     }
 
     #[test]

@@ -96,7 +96,7 @@ use modulation::MediumConsts;
 use shadows::in_intervals;
 use triangles::MeshShadows;
 
-use super::{Integrator, IntegratorError, IntegratorKind, no_extra, single_scattering};
+use super::{Integrator, IntegratorError, IntegratorKind, RadianceParts, no_extra, single_scattering_parts};
 use crate::Rgb;
 use crate::geometry::Ray;
 use crate::light::{AttenuationModel, Light, SpotProfile};
@@ -192,6 +192,12 @@ pub struct Analytic {
 const MODULATED_POINTS: usize = 16;
 
 impl Analytic {
+    fn parts(&self, scene: &Scene, ray: &Ray, sampler: &mut Sampler) -> RadianceParts {
+        single_scattering_parts(scene, ray, sampler, no_extra, |medium, length, _| {
+            self.in_scattered(scene, medium, ray, length)
+        })
+    }
+
     /// The integrator for `scene`, or why it cannot render it (a message for
     /// the user, never a panic): height fog, volume lights, distant lights
     /// in a medium, non-physical attenuation models, and with shadows SDF
@@ -492,9 +498,11 @@ struct Scratch {
 
 impl Integrator for Analytic {
     fn radiance(&self, scene: &Scene, ray: &Ray, sampler: &mut Sampler) -> Rgb {
-        single_scattering(scene, ray, sampler, no_extra, |medium, length, _| {
-            self.in_scattered(scene, medium, ray, length)
-        })
+        self.parts(scene, ray, sampler).total()
+    }
+
+    fn radiance_parts(&self, scene: &Scene, ray: &Ray, sampler: &mut Sampler) -> Option<RadianceParts> {
+        Some(self.parts(scene, ray, sampler))
     }
 
     /// Emitters and blockers are placed where the lights are: rebuilt.

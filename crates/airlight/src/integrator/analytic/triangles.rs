@@ -84,7 +84,7 @@ impl MeshShadows {
                 }
                 other => other,
             };
-            if let Shape::Mesh { positions, triangles: indices } = shape {
+            if let Shape::Mesh { positions, triangles: indices, .. } = shape {
                 for tri in indices {
                     triangles.push(tri.map(|i| positions.get(i as usize).map_or(DVec3::NAN, |p| p.as_dvec3())));
                 }
