@@ -413,3 +413,14 @@ fn seeds_606_2402_3374_3912_sphere_lights_near_occluders_cast_penumbrae() {
         check(seed).unwrap();
     }
 }
+
+/// Open scenes under a sun with an infinite floor: radiosity cut the floor
+/// only in a square around the objects, so the bounce light from the rest
+/// of the sunlit floor was missing (seed 3122: a box's side got a fifth of
+/// the path tracer's light); now coarse rings extend it 64 times further.
+#[test]
+fn seeds_1271_1465_3122_4432_a_sunlit_floor_bounces_light_from_beyond_the_objects() {
+    for seed in [1271, 1465, 3122, 4432] {
+        check(seed).unwrap();
+    }
+}
