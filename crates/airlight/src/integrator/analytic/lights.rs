@@ -39,9 +39,10 @@ pub(super) enum Extended {
         radius: f64,
         radiance: DVec3,
         light: u32,
-        /// Whether a surface comes within [`NEAR_RADII`] radii of the
-        /// sphere (with shadows): its penumbrae are then wide, and the hard
-        /// shadow of a point at the centre would misplace them.
+        /// Whether a surface that can cast a penumbra comes within
+        /// [`NEAR_RADII`] radii of the sphere (with shadows): its penumbrae
+        /// are then wide, and the hard shadow of a point at the centre would
+        /// misplace them.
         near_surface: bool,
     },
 }

@@ -37,7 +37,7 @@
 //! set of points fails for rays that pass closer to the light than a few
 //! point spacings (each point then shows its own glow), so per ray a piece
 //! of the light that the ray passes close to is halved (line, up to 8
-//! times) or quartered (quad, up to 3 times) and the rule applied on each
+//! times) or quartered (quad and triangle, up to 5 times) and the rule applied on each
 //! part: an adaptive composite rule, which leaves far rays with n points.
 //! A sphere light of radiance L and
 //! radius R is, for points outside it, a point light of intensity
