@@ -151,6 +151,12 @@ fn random_scene(seed: u64) -> Scene {
     b.build().unwrap()
 }
 
+/// The blocks agreement is judged on: the whole image and its quarters.
+fn blocks() -> [(std::ops::Range<u32>, std::ops::Range<u32>); 5] {
+    let h = SIZE / 2;
+    [(0..SIZE, 0..SIZE), (0..h, 0..h), (h..SIZE, 0..h), (0..h, h..SIZE), (h..SIZE, h..SIZE)]
+}
+
 /// Mean and squared standard error of the mean over a block of pixels.
 fn block(acc: &Accumulator, xs: std::ops::Range<u32>, ys: std::ops::Range<u32>) -> (f64, f64) {
     let (mut mean, mut var, mut n) = (0.0, 0.0, 0.0);
@@ -194,9 +200,7 @@ fn brightest_patch(scene: &Scene, r: &RadiosityIntegrator) -> f64 {
 /// image mean and each quarter; the worst disagreement as a multiple of
 /// what is allowed.
 fn agreement_within(a: &Accumulator, b: &Accumulator, scale: f64) -> f64 {
-    let h = SIZE / 2;
-    let blocks = [(0..SIZE, 0..SIZE), (0..h, 0..h), (h..SIZE, 0..h), (0..h, h..SIZE), (h..SIZE, h..SIZE)];
-    blocks
+    blocks()
         .into_iter()
         .map(|(xs, ys)| {
             let ((ma, va), (mb, vb)) = (block(a, xs.clone(), ys.clone()), block(b, xs, ys));
@@ -208,9 +212,7 @@ fn agreement_within(a: &Accumulator, b: &Accumulator, scale: f64) -> f64 {
 /// Whether `a` and `b` agree (image mean and each quarter); the worst
 /// disagreement as a multiple of what is allowed.
 fn agreement(a: &Accumulator, b: &Accumulator, tol: f64) -> f64 {
-    let h = SIZE / 2;
-    let blocks = [(0..SIZE, 0..SIZE), (0..h, 0..h), (h..SIZE, 0..h), (0..h, h..SIZE), (h..SIZE, h..SIZE)];
-    blocks
+    blocks()
         .into_iter()
         .map(|(xs, ys)| {
             let ((ma, va), (mb, vb)) = (block(a, xs.clone(), ys.clone()), block(b, xs, ys));
@@ -223,9 +225,7 @@ fn agreement(a: &Accumulator, b: &Accumulator, tol: f64) -> f64 {
 /// Prints the blocks' means and standard errors of `a` and `b`
 /// (`AIRLIGHT_DIFF_DEBUG`).
 fn print_blocks(name: &str, a: &Accumulator, b: &Accumulator) {
-    let h = SIZE / 2;
-    let blocks = [(0..SIZE, 0..SIZE), (0..h, 0..h), (h..SIZE, 0..h), (0..h, h..SIZE), (h..SIZE, h..SIZE)];
-    for (xs, ys) in blocks {
+    for (xs, ys) in blocks() {
         let ((ma, va), (mb, vb)) = (block(a, xs.clone(), ys.clone()), block(b, xs.clone(), ys.clone()));
         eprintln!("{name} {xs:?}×{ys:?}: {ma:.6} ± {:.6} against {mb:.6} ± {:.6}", va.sqrt(), vb.sqrt());
     }
