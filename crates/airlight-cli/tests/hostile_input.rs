@@ -179,17 +179,23 @@ fn attenuation_at_the_ends_of_f32_fails_with_a_message() {
 
 #[test]
 fn info_into_a_closed_pipe_ends_quietly() {
+    use std::os::fd::FromRawFd;
     use std::os::unix::process::ExitStatusExt;
     let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/room_moving_lights.toml");
-    let mut child = Command::new(env!("CARGO_BIN_EXE_airlight"))
+    // As `| head -0`: the pipe's reading end is closed before the child
+    // starts, so its first write meets a closed pipe (closing it after the
+    // spawn raced a quick child, which could finish writing first).
+    let mut fds = [0; 2];
+    assert_eq!(unsafe { libc::pipe(fds.as_mut_ptr()) }, 0);
+    let (read_end, write_end) =
+        unsafe { (std::os::fd::OwnedFd::from_raw_fd(fds[0]), std::os::fd::OwnedFd::from_raw_fd(fds[1])) };
+    drop(read_end);
+    let child = Command::new(env!("CARGO_BIN_EXE_airlight"))
         .args(["info", scene.to_str().unwrap()])
-        .stdout(Stdio::piped())
+        .stdout(Stdio::from(write_end))
         .stderr(Stdio::piped())
         .spawn()
         .unwrap();
-    // As `| head -0`: the reader is gone before the first line (the scene
-    // takes milliseconds to load), so the first write meets a closed pipe.
-    drop(child.stdout.take());
     let out = child.wait_with_output().unwrap();
     assert_eq!(out.status.signal(), Some(13), "killed by SIGPIPE, as `cat` would be: {:?}", out.status);
     assert_eq!(stderr(&out), "", "no panic, no message");
