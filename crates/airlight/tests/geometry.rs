@@ -250,7 +250,7 @@ fn bvh_agrees_with_brute_force_in(scene: &str, min_hits: u32) {
     let geometry = scene.geometry();
     let (lo, hi) = geometry.bounds().expect("bounded geometry");
     let mut s = Sampler::for_pixel(3, 1, 4);
-    let (mut hits, mut ties) = (0, 0);
+    let mut hits = 0;
     for _ in 0..20_000 {
         let o = lo + (hi - lo) * Vec3::new(s.next(), s.next(), s.next());
         let d = uniform_sphere(s.next2());
@@ -258,13 +258,11 @@ fn bvh_agrees_with_brute_force_in(scene: &str, min_hits: u32) {
         let tmax = if s.next() < 0.5 { f32::INFINITY } else { (hi - lo).length() * s.next() };
         let fast = geometry.intersect(&ray, tmax);
         let slow = geometry.intersect_brute_force(&ray, tmax);
-        assert_eq!(fast.map(|h| h.t), slow.map(|h| h.t), "ray {o} {d}");
+        // The same distance and the same primitive: of equal distances (a
+        // shared edge, coinciding faces) both name the lowest index.
+        assert_eq!(fast, slow, "ray {o} {d}");
         assert_eq!(geometry.occluded(o, d, tmax), slow.is_some(), "ray {o} {d}");
         hits += slow.is_some() as u32;
-        ties += (fast != slow) as u32;
     }
     assert!(hits > min_hits, "hits {hits}");
-    // Equal distances to two primitives (a shared edge) may name either:
-    // the distances agree (asserted above), the primitive may not.
-    eprintln!("{hits} hits, {ties} at a tie named another primitive");
 }

@@ -5,6 +5,7 @@
 
 use super::Ray;
 use super::bvh4::{self, BoxRay, Bvh4};
+use super::batch::{comes_before, test_bound};
 use super::sdf::{Sdf, sphere_trace};
 use super::shape::{Shape, box_normal, intersect_box, intersect_quad, intersect_sphere, intersect_triangle};
 use glam::{Affine3A, Mat3, Vec2, Vec3, Vec3A};
@@ -164,16 +165,21 @@ thread_local! {
     static SHADOW_RAYS: std::cell::Cell<u64> = const { std::cell::Cell::new(0) };
 }
 
-/// The number of shadow rays (`occluded` calls) this thread has traced.
+/// The number of shadow rays (`occluded` calls and segments of
+/// `occluded_packet` calls) this thread has traced.
 pub fn shadow_rays_traced() -> u64 {
     SHADOW_RAYS.with(|n| n.get())
+}
+
+pub(super) fn count_shadow_rays(n: u64) {
+    SHADOW_RAYS.with(|c| c.set(c.get() + n));
 }
 
 /// What a ray hit: its distance and which primitive.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Hit {
     pub t: f32,
-    id: u32,
+    pub(super) id: u32,
 }
 
 /// The local geometry at a hit point.
@@ -200,7 +206,7 @@ pub struct Geometry {
     unbounded: Vec<UnboundedSdf>,
     /// Each record's triangle as (v0, e1, e2), zeros for other primitives:
     /// the compact copy that traversal reads, one 36-byte entry per record.
-    triangles: Vec<[Vec3; 3]>,
+    pub(super) triangles: Vec<[Vec3; 3]>,
     /// None when there are few primitives: testing them all is faster.
     bvh: Option<Bvh4>,
     bounds: Option<(Vec3, Vec3)>,
@@ -359,12 +365,12 @@ impl Geometry {
             Some(bvh) => {
                 let (o, d) = (ray.origin, ray.dir);
                 let box_ray = BoxRay::new(o.to_array(), d.to_array());
-                let found = bvh.closest(&box_ray, tmax, |first, count, mixed, mut best_t| {
+                let found = bvh.closest(&box_ray, tmax, |first, count, mixed, (mut best_t, mut best_id)| {
                     let mut found = None;
                     for i in first..first + count {
-                        let t = self.intersect_one(i as usize, mixed, o, d, best_t);
-                        if t < best_t {
-                            best_t = t;
+                        let t = self.intersect_one(i as usize, mixed, o, d, test_bound(best_t, best_id));
+                        if comes_before(t, i, best_t, best_id) {
+                            (best_t, best_id) = (t, i);
                             found = Some((t, i));
                         }
                     }
@@ -388,7 +394,7 @@ impl Geometry {
     }
 
     /// Planes and unbounded SDFs, tested one by one after the bounded primitives.
-    fn intersect_unbounded(&self, ray: &Ray, best: &mut Hit) {
+    pub(super) fn intersect_unbounded(&self, ray: &Ray, best: &mut Hit) {
         let base = self.records.len() as u32;
         for (i, plane) in self.planes.iter().enumerate() {
             let t = intersect_plane(plane, ray.origin, ray.dir);
@@ -407,7 +413,36 @@ impl Geometry {
 
     /// Whether anything lies on the open segment `origin + t·dir`, 0 < t < tmax.
     pub fn occluded(&self, origin: Vec3, dir: Vec3, tmax: f32) -> bool {
-        SHADOW_RAYS.with(|n| n.set(n.get() + 1));
+        count_shadow_rays(1);
+        if self.occluded_unbounded(origin, dir, tmax) {
+            return true;
+        }
+        match &self.bvh {
+            Some(bvh) => self.occluded_bvh(bvh, origin, dir, tmax),
+            None => self.occluded_linear(origin, dir, tmax),
+        }
+    }
+
+    /// Whether a primitive in the tree blocks the segment.
+    pub(super) fn occluded_bvh(&self, bvh: &Bvh4, origin: Vec3, dir: Vec3, tmax: f32) -> bool {
+        let box_ray = BoxRay::new(origin.to_array(), dir.to_array());
+        bvh.any(&box_ray, tmax, |first, count, mixed| {
+            (first..first + count).any(|i| self.intersect_one(i as usize, mixed, origin, dir, tmax) < tmax)
+        })
+    }
+
+    /// Whether a bounded primitive blocks the segment, testing them all.
+    pub(super) fn occluded_linear(&self, origin: Vec3, dir: Vec3, tmax: f32) -> bool {
+        self.records.iter().any(|rec| rec.prim.intersect(origin, dir, 0.0, tmax) < tmax)
+    }
+
+    /// The tree, if the scene has one.
+    pub(super) fn bvh(&self) -> Option<&Bvh4> {
+        self.bvh.as_ref()
+    }
+
+    /// Whether a plane or unbounded SDF blocks the segment.
+    pub(super) fn occluded_unbounded(&self, origin: Vec3, dir: Vec3, tmax: f32) -> bool {
         for plane in &self.planes {
             let t = intersect_plane(plane, origin, dir);
             if t > 0.0 && t < tmax {
@@ -420,21 +455,13 @@ impl Geometry {
                 return true;
             }
         }
-        match &self.bvh {
-            Some(bvh) => {
-                let box_ray = BoxRay::new(origin.to_array(), dir.to_array());
-                bvh.any(&box_ray, tmax, |first, count, mixed| {
-                    (first..first + count).any(|i| self.intersect_one(i as usize, mixed, origin, dir, tmax) < tmax)
-                })
-            }
-            None => self.records.iter().any(|rec| rec.prim.intersect(origin, dir, 0.0, tmax) < tmax),
-        }
+        false
     }
 
     /// Record `i`'s hit distance in (0, tmax), or infinity: from the compact
     /// triangle copy when its leaf holds only triangles.
     #[inline(always)]
-    fn intersect_one(&self, i: usize, mixed: bool, o: Vec3, d: Vec3, tmax: f32) -> f32 {
+    pub(super) fn intersect_one(&self, i: usize, mixed: bool, o: Vec3, d: Vec3, tmax: f32) -> f32 {
         if mixed {
             self.records[i].prim.intersect(o, d, 0.0, tmax)
         } else {

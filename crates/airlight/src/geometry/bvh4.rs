@@ -17,20 +17,20 @@ use obvhs::bvh2::Bvh2;
 /// its box is empty (min = +∞, max = −∞, which no ray hits).
 #[derive(Clone, Copy, Debug)]
 #[repr(C, align(64))]
-struct Node4 {
+pub(super) struct Node4 {
     /// min x, min y, min z, max x, max y, max z, each for four children.
-    bounds: [[f32; 4]; 6],
-    child: [u32; 4],
-    count: [u32; 4],
+    pub(super) bounds: [[f32; 4]; 6],
+    pub(super) child: [u32; 4],
+    pub(super) count: [u32; 4],
 }
 
 /// Set in a leaf's count when one of its primitives is not a triangle, so
 /// that the caller takes its general path.
 pub const LEAF_MIXED: u32 = 1 << 31;
-const COUNT_MASK: u32 = !LEAF_MIXED;
+pub(super) const COUNT_MASK: u32 = !LEAF_MIXED;
 
 /// Entries the traversal stack holds: three per level below the root, plus one.
-const STACK_SIZE: usize = 192;
+pub(super) const STACK_SIZE: usize = 192;
 /// The deepest tree the stack can hold.
 pub const MAX_DEPTH: usize = (STACK_SIZE - 1) / 3;
 
@@ -51,7 +51,7 @@ const EMPTY: Node4 = Node4 {
 /// obvhs tree's `primitive_indices` order.
 #[derive(Clone, Debug)]
 pub struct Bvh4 {
-    nodes: Vec<Node4>,
+    pub(super) nodes: Vec<Node4>,
     depth: usize,
 }
 
@@ -72,8 +72,7 @@ impl BoxRay {
         let mut inv_dir = [0.0; 3];
         let mut near = [0; 3];
         for a in 0..3 {
-            let d = if dir[a].abs() < 1e-30 { 1e-30f32.copysign(dir[a]) } else { dir[a] };
-            inv_dir[a] = 1.0 / d;
+            inv_dir[a] = super::packet::reciprocal(dir[a]);
             near[a] = if inv_dir[a] >= 0.0 { a } else { a + 3 };
         }
         BoxRay { origin, inv_dir, near }
@@ -82,7 +81,7 @@ impl BoxRay {
 
 /// Grows the far slab distance by a few ulps so that rounding never culls a
 /// box the ray grazes (Ize, "Robust BVH ray traversal", 2013).
-const FAR_SCALE: f32 = 1.0 + 4.0 * f32::EPSILON;
+pub(super) const FAR_SCALE: f32 = 1.0 + 4.0 * f32::EPSILON;
 
 /// The entry distances of the four children and a bit mask of those the ray
 /// segment [0, tmax] enters.
@@ -133,7 +132,7 @@ fn hit4(node: &Node4, ray: &BoxRay, tmax: f32) -> (u32, [f32; 4]) {
 
 /// The row of the far plane on an axis, given the near plane's row.
 #[inline(always)]
-fn far_row(near: usize, axis: usize) -> usize {
+pub(super) fn far_row(near: usize, axis: usize) -> usize {
     if near == axis { axis + 3 } else { axis }
 }
 
@@ -231,14 +230,17 @@ impl Bvh4 {
     }
 
     /// The nearest hit on the segment (0, tmax): `leaf(first, count, mixed,
-    /// best)` tests a leaf's primitives and returns its nearest hit closer
-    /// than `best` as (t, primitive), if any. Returns the nearest (t, primitive).
+    /// best)` tests a leaf's primitives and returns its nearest hit that
+    /// comes before `best` = (t, primitive) — closer, or as close with a
+    /// lower primitive index (u32::MAX while there is none) —, if any.
+    /// Returns the nearest (t, primitive), of equal distances the lowest
+    /// index, so that the answer does not depend on the order of visits.
     #[inline]
     pub fn closest(
         &self,
         ray: &BoxRay,
         tmax: f32,
-        mut leaf: impl FnMut(u32, u32, bool, f32) -> Option<(f32, u32)>,
+        mut leaf: impl FnMut(u32, u32, bool, (f32, u32)) -> Option<(f32, u32)>,
     ) -> Option<(f32, u32)> {
         let mut best: Option<(f32, u32)> = None;
         let mut best_t = tmax;
@@ -247,7 +249,8 @@ impl Bvh4 {
         loop {
             if current.count != 0 {
                 let mixed = current.count & LEAF_MIXED != 0;
-                if let Some(hit) = leaf(current.child, current.count & COUNT_MASK, mixed, best_t) {
+                let best_id = best.map_or(u32::MAX, |b| b.1);
+                if let Some(hit) = leaf(current.child, current.count & COUNT_MASK, mixed, (best_t, best_id)) {
                     best_t = hit.0;
                     best = Some(hit);
                 }

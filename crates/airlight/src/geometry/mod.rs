@@ -1,11 +1,14 @@
 //! Rays, shapes and the acceleration structure that finds what a ray hits.
 
 mod accel;
+mod batch;
 mod bvh4;
+mod packet;
 mod ray;
 pub mod sdf;
 mod shape;
 
+pub use batch::Segment;
 pub use accel::{Geometry, GeometryBuilder, Hit, SurfaceHit, shadow_rays_traced};
 pub use ray::{Ray, offset_origin};
 pub use sdf::Sdf;

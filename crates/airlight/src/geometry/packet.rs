@@ -1,0 +1,471 @@
+//! Packets of up to 64 coherent rays traced together through the 4-wide BVH
+//! (`bvh4.rs`), for camera rays of neighbouring pixels and shadow rays from
+//! them toward one light.
+//!
+//! Each node is fetched once for the whole packet. Its four child boxes are
+//! first tested against the packet as a whole by interval arithmetic (the
+//! range of origins and of reciprocal directions, Boulos et al., "Packet-based
+//! Whitted and distribution ray tracing", 2007), which drops children that no
+//! ray of the packet can enter without testing any ray. A child that passes
+//! is then tested ray by ray, four rays at a time, when it is visited (so
+//! that the rays' nearest hits found meanwhile cull it), and only the rays
+//! that enter it go on. Leaves test their triangles against four rays at a
+//! time with the same arithmetic, operation for operation, as the one-ray
+//! [`intersect_triangle`](super::intersect_triangle), so a ray's hit
+//! distance is the same bits whichever way it is traced.
+//!
+//! All rays of a packet share their direction's sign on each axis (the
+//! caller groups rays so), which makes the near plane of every box the same
+//! for all of them. Four-ray arithmetic is written once over [`Lanes`]: SSE
+//! on x86-64 (its baseline), and a scalar type with the same operations,
+//! which other targets use and the tests run too.
+
+use super::bvh4::{Bvh4, COUNT_MASK, FAR_SCALE, LEAF_MIXED, Node4, STACK_SIZE, far_row};
+use glam::Vec3;
+
+/// The most rays a packet holds: one bit each in a `u64` mask.
+pub const PACKET: usize = 64;
+
+/// Four f32 lanes and the operations the traversal needs. Comparisons give
+/// a 4-bit mask (bit i for lane i) and, like Rust's scalar comparisons, are
+/// false when either side is NaN.
+pub trait Lanes: Copy {
+    fn splat(x: f32) -> Self;
+    /// Lanes from `s[0..4]`.
+    fn load(s: &[f32]) -> Self;
+    fn to_array(self) -> [f32; 4];
+    fn add(self, o: Self) -> Self;
+    fn sub(self, o: Self) -> Self;
+    fn mul(self, o: Self) -> Self;
+    fn div(self, o: Self) -> Self;
+    /// `self.min(o)` where neither is NaN.
+    fn min(self, o: Self) -> Self;
+    /// `self.max(o)` where neither is NaN.
+    fn max(self, o: Self) -> Self;
+    fn abs(self) -> Self;
+    fn lt(self, o: Self) -> u32;
+    fn le(self, o: Self) -> u32;
+    fn eq(self, o: Self) -> u32;
+}
+
+/// The portable lanes: a loop over four f32s.
+#[derive(Clone, Copy, Debug)]
+pub struct Scalar4([f32; 4]);
+
+impl Scalar4 {
+    #[inline(always)]
+    fn map2(self, o: Self, f: impl Fn(f32, f32) -> f32) -> Self {
+        Scalar4(std::array::from_fn(|i| f(self.0[i], o.0[i])))
+    }
+
+    #[inline(always)]
+    fn mask(self, o: Self, f: impl Fn(f32, f32) -> bool) -> u32 {
+        (0..4).fold(0, |m, i| m | ((f(self.0[i], o.0[i]) as u32) << i))
+    }
+}
+
+impl Lanes for Scalar4 {
+    #[inline(always)]
+    fn splat(x: f32) -> Self {
+        Scalar4([x; 4])
+    }
+    #[inline(always)]
+    fn load(s: &[f32]) -> Self {
+        Scalar4([s[0], s[1], s[2], s[3]])
+    }
+    #[inline(always)]
+    fn to_array(self) -> [f32; 4] {
+        self.0
+    }
+    #[inline(always)]
+    fn add(self, o: Self) -> Self {
+        self.map2(o, |a, b| a + b)
+    }
+    #[inline(always)]
+    fn sub(self, o: Self) -> Self {
+        self.map2(o, |a, b| a - b)
+    }
+    #[inline(always)]
+    fn mul(self, o: Self) -> Self {
+        self.map2(o, |a, b| a * b)
+    }
+    #[inline(always)]
+    fn div(self, o: Self) -> Self {
+        self.map2(o, |a, b| a / b)
+    }
+    #[inline(always)]
+    fn min(self, o: Self) -> Self {
+        self.map2(o, |a, b| if a < b { a } else { b })
+    }
+    #[inline(always)]
+    fn max(self, o: Self) -> Self {
+        self.map2(o, |a, b| if a > b { a } else { b })
+    }
+    #[inline(always)]
+    fn abs(self) -> Self {
+        Scalar4(self.0.map(f32::abs))
+    }
+    #[inline(always)]
+    fn lt(self, o: Self) -> u32 {
+        self.mask(o, |a, b| a < b)
+    }
+    #[inline(always)]
+    fn le(self, o: Self) -> u32 {
+        self.mask(o, |a, b| a <= b)
+    }
+    #[inline(always)]
+    fn eq(self, o: Self) -> u32 {
+        self.mask(o, |a, b| a == b)
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+pub use sse::Sse4;
+
+#[cfg(target_arch = "x86_64")]
+mod sse {
+    use super::Lanes;
+    use std::arch::x86_64::*;
+
+    /// Four lanes in an SSE register.
+    #[derive(Clone, Copy, Debug)]
+    pub struct Sse4(__m128);
+
+    // SAFETY (every function below): SSE and SSE2 are part of the x86-64
+    // baseline; `load` reads four f32s from a slice of at least four (the
+    // indexing checks it) with an unaligned load.
+    impl Lanes for Sse4 {
+        #[inline(always)]
+        fn splat(x: f32) -> Self {
+            unsafe { Sse4(_mm_set1_ps(x)) }
+        }
+        #[inline(always)]
+        fn load(s: &[f32]) -> Self {
+            let s = &s[..4];
+            unsafe { Sse4(_mm_loadu_ps(s.as_ptr())) }
+        }
+        #[inline(always)]
+        fn to_array(self) -> [f32; 4] {
+            let mut out = [0.0; 4];
+            unsafe { _mm_storeu_ps(out.as_mut_ptr(), self.0) };
+            out
+        }
+        #[inline(always)]
+        fn add(self, o: Self) -> Self {
+            unsafe { Sse4(_mm_add_ps(self.0, o.0)) }
+        }
+        #[inline(always)]
+        fn sub(self, o: Self) -> Self {
+            unsafe { Sse4(_mm_sub_ps(self.0, o.0)) }
+        }
+        #[inline(always)]
+        fn mul(self, o: Self) -> Self {
+            unsafe { Sse4(_mm_mul_ps(self.0, o.0)) }
+        }
+        #[inline(always)]
+        fn div(self, o: Self) -> Self {
+            unsafe { Sse4(_mm_div_ps(self.0, o.0)) }
+        }
+        #[inline(always)]
+        fn min(self, o: Self) -> Self {
+            unsafe { Sse4(_mm_min_ps(self.0, o.0)) }
+        }
+        #[inline(always)]
+        fn max(self, o: Self) -> Self {
+            unsafe { Sse4(_mm_max_ps(self.0, o.0)) }
+        }
+        #[inline(always)]
+        fn abs(self) -> Self {
+            unsafe { Sse4(_mm_and_ps(self.0, _mm_castsi128_ps(_mm_set1_epi32(i32::MAX)))) }
+        }
+        #[inline(always)]
+        fn lt(self, o: Self) -> u32 {
+            unsafe { _mm_movemask_ps(_mm_cmplt_ps(self.0, o.0)) as u32 }
+        }
+        #[inline(always)]
+        fn le(self, o: Self) -> u32 {
+            unsafe { _mm_movemask_ps(_mm_cmple_ps(self.0, o.0)) as u32 }
+        }
+        #[inline(always)]
+        fn eq(self, o: Self) -> u32 {
+            unsafe { _mm_movemask_ps(_mm_cmpeq_ps(self.0, o.0)) as u32 }
+        }
+    }
+}
+
+/// The lanes this target traces with.
+#[cfg(target_arch = "x86_64")]
+pub type NativeLanes = Sse4;
+#[cfg(not(target_arch = "x86_64"))]
+pub type NativeLanes = Scalar4;
+
+/// Up to [`PACKET`] rays in structure of arrays, all with the same direction
+/// signs, with each ray's nearest hit so far (`tmax`, and `id`, u32::MAX
+/// for none). Lanes past `len` hold copies of lane 0 and are never active.
+#[repr(C, align(64))]
+pub struct Packet {
+    pub origin: [[f32; PACKET]; 3],
+    pub dir: [[f32; PACKET]; 3],
+    /// Reciprocal directions, zeros replaced as in [`super::bvh4::BoxRay`].
+    inv_dir: [[f32; PACKET]; 3],
+    pub tmax: [f32; PACKET],
+    pub id: [u32; PACKET],
+    pub len: usize,
+    /// The row of each axis's near plane in a node's bounds.
+    near: [usize; 3],
+    /// Ranges over the packet's rays of origin and reciprocal direction per
+    /// axis, and the largest tmax.
+    origin_lo: [f32; 3],
+    origin_hi: [f32; 3],
+    inv_lo: [f32; 3],
+    inv_hi: [f32; 3],
+    tmax_hi: f32,
+}
+
+/// The reciprocal of a direction component, zero replaced by a tiny value
+/// of the same sign (so that no 0·∞ appears): what single-ray box tests use.
+#[inline]
+pub fn reciprocal(d: f32) -> f32 {
+    1.0 / if d.abs() < 1e-30 { 1e-30f32.copysign(d) } else { d }
+}
+
+/// Which octant a direction points into: bit a set when its reciprocal on
+/// axis a is negative. Rays of one packet must share it.
+#[inline]
+pub fn octant(dir: Vec3) -> usize {
+    (0..3).fold(0, |o, a| o | (((reciprocal(dir[a]) < 0.0) as usize) << a))
+}
+
+impl Packet {
+    /// A packet of `rays` (origin, direction, tmax), at most [`PACKET`] of
+    /// them, all in one [`octant`].
+    pub fn new(rays: impl ExactSizeIterator<Item = (Vec3, Vec3, f32)>) -> Box<Packet> {
+        let len = rays.len();
+        assert!((1..=PACKET).contains(&len), "a packet holds 1 to {PACKET} rays, not {len}");
+        let mut p = Box::new(Packet {
+            origin: [[0.0; PACKET]; 3],
+            dir: [[0.0; PACKET]; 3],
+            inv_dir: [[0.0; PACKET]; 3],
+            tmax: [0.0; PACKET],
+            id: [u32::MAX; PACKET],
+            len,
+            near: [0; 3],
+            origin_lo: [f32::INFINITY; 3],
+            origin_hi: [f32::NEG_INFINITY; 3],
+            inv_lo: [f32::INFINITY; 3],
+            inv_hi: [f32::NEG_INFINITY; 3],
+            tmax_hi: 0.0,
+        });
+        p.fill(rays);
+        p
+    }
+
+    /// Refills the packet with new rays (the same contract as [`Packet::new`]),
+    /// reusing its storage.
+    pub fn fill(&mut self, rays: impl ExactSizeIterator<Item = (Vec3, Vec3, f32)>) {
+        let len = rays.len();
+        assert!((1..=PACKET).contains(&len), "a packet holds 1 to {PACKET} rays, not {len}");
+        self.len = len;
+        self.origin_lo = [f32::INFINITY; 3];
+        self.origin_hi = [f32::NEG_INFINITY; 3];
+        self.inv_lo = [f32::INFINITY; 3];
+        self.inv_hi = [f32::NEG_INFINITY; 3];
+        self.tmax_hi = f32::NEG_INFINITY;
+        let mut first_octant = None;
+        for (i, (o, d, tmax)) in rays.enumerate() {
+            let oct = octant(d);
+            assert_eq!(*first_octant.get_or_insert(oct), oct, "rays of a packet must share their octant");
+            for a in 0..3 {
+                let inv = reciprocal(d[a]);
+                self.origin[a][i] = o[a];
+                self.dir[a][i] = d[a];
+                self.inv_dir[a][i] = inv;
+                self.origin_lo[a] = self.origin_lo[a].min(o[a]);
+                self.origin_hi[a] = self.origin_hi[a].max(o[a]);
+                self.inv_lo[a] = self.inv_lo[a].min(inv);
+                self.inv_hi[a] = self.inv_hi[a].max(inv);
+            }
+            self.tmax[i] = tmax;
+            self.tmax_hi = self.tmax_hi.max(tmax);
+            self.id[i] = u32::MAX;
+        }
+        let oct = first_octant.unwrap_or(0);
+        self.near = std::array::from_fn(|a| if oct & (1 << a) == 0 { a } else { a + 3 });
+        for i in len..PACKET {
+            for a in 0..3 {
+                self.origin[a][i] = self.origin[a][0];
+                self.dir[a][i] = self.dir[a][0];
+                self.inv_dir[a][i] = self.inv_dir[a][0];
+            }
+            self.tmax[i] = self.tmax[0];
+            self.id[i] = u32::MAX;
+        }
+    }
+
+    /// The mask of all the packet's rays.
+    pub fn all(&self) -> u64 {
+        if self.len == PACKET { u64::MAX } else { (1u64 << self.len) - 1 }
+    }
+
+    /// Ray `i`'s origin and direction.
+    pub fn ray(&self, i: usize) -> (Vec3, Vec3) {
+        let o = Vec3::new(self.origin[0][i], self.origin[1][i], self.origin[2][i]);
+        let d = Vec3::new(self.dir[0][i], self.dir[1][i], self.dir[2][i]);
+        (o, d)
+    }
+
+    /// Of the rays in `mask`, those whose segment [0, tmax] enters child
+    /// `c`'s box of `node`: the single-ray test, four rays at a time.
+    #[inline(always)]
+    fn enter<L: Lanes>(&self, node: &Node4, c: usize, mask: u64) -> u64 {
+        let mut out = 0;
+        let mut groups = mask;
+        while groups != 0 {
+            let g = groups.trailing_zeros() as usize / 4;
+            let bits = (mask >> (4 * g)) & 0xF;
+            groups &= !(0xFu64 << (4 * g));
+            let s = 4 * g;
+            let slab = |row: usize, a: usize| {
+                L::splat(node.bounds[row][c]).sub(L::load(&self.origin[a][s..])).mul(L::load(&self.inv_dir[a][s..]))
+            };
+            let n = [slab(self.near[0], 0), slab(self.near[1], 1), slab(self.near[2], 2)];
+            let f = [
+                slab(far_row(self.near[0], 0), 0),
+                slab(far_row(self.near[1], 1), 1),
+                slab(far_row(self.near[2], 2), 2),
+            ];
+            let tnear = n[0].max(n[1]).max(n[2].max(L::splat(0.0)));
+            let tfar = f[0].min(f[1]).min(f[2].min(L::load(&self.tmax[s..]))).mul(L::splat(FAR_SCALE));
+            out |= ((tnear.le(tfar) as u64) & bits) << s;
+        }
+        out
+    }
+
+    /// Which of `node`'s four children some ray of the packet may enter
+    /// (bit c for child c), and a lower bound on every ray's entry distance
+    /// into each: interval arithmetic over the packet's ranges of origins
+    /// and reciprocal directions. Rounding is monotonic, so the bounds hold
+    /// the values each ray's own test computes, and no child that a ray
+    /// enters is dropped.
+    #[inline(always)]
+    fn children<L: Lanes>(&self, node: &Node4) -> (u32, [f32; 4]) {
+        let range = |row: usize, a: usize| {
+            let plane = L::load(&node.bounds[row]);
+            let (d_lo, d_hi) = (plane.sub(L::splat(self.origin_hi[a])), plane.sub(L::splat(self.origin_lo[a])));
+            let (i_lo, i_hi) = (L::splat(self.inv_lo[a]), L::splat(self.inv_hi[a]));
+            let (p0, p1, p2, p3) = (d_lo.mul(i_lo), d_lo.mul(i_hi), d_hi.mul(i_lo), d_hi.mul(i_hi));
+            (p0.min(p1).min(p2.min(p3)), p0.max(p1).max(p2.max(p3)))
+        };
+        let n = [range(self.near[0], 0).0, range(self.near[1], 1).0, range(self.near[2], 2).0];
+        let f = [
+            range(far_row(self.near[0], 0), 0).1,
+            range(far_row(self.near[1], 1), 1).1,
+            range(far_row(self.near[2], 2), 2).1,
+        ];
+        let tnear = n[0].max(n[1]).max(n[2].max(L::splat(0.0)));
+        let tfar = f[0].min(f[1]).min(f[2].min(L::splat(self.tmax_hi))).mul(L::splat(FAR_SCALE));
+        (tnear.le(tfar), tnear.to_array())
+    }
+
+    /// Möller–Trumbore against rays `s..s + 4`, operation for operation as
+    /// [`super::intersect_triangle`]: the mask of lanes with a hit at t > 0
+    /// (no upper bound applied) and the lanes' t.
+    #[inline(always)]
+    pub fn triangle4<L: Lanes>(&self, s: usize, v0: Vec3, e1: Vec3, e2: Vec3) -> (u32, L) {
+        let d = [L::load(&self.dir[0][s..]), L::load(&self.dir[1][s..]), L::load(&self.dir[2][s..])];
+        let o = [L::load(&self.origin[0][s..]), L::load(&self.origin[1][s..]), L::load(&self.origin[2][s..])];
+        let [e1, e2] = [e1, e2].map(|e| [L::splat(e.x), L::splat(e.y), L::splat(e.z)]);
+        let cross = |a: &[L; 3], b: &[L; 3]| {
+            [
+                a[1].mul(b[2]).sub(b[1].mul(a[2])),
+                a[2].mul(b[0]).sub(b[2].mul(a[0])),
+                a[0].mul(b[1]).sub(b[0].mul(a[1])),
+            ]
+        };
+        let dot = |a: &[L; 3], b: &[L; 3]| a[0].mul(b[0]).add(a[1].mul(b[1])).add(a[2].mul(b[2]));
+        let pvec = cross(&d, &e2);
+        let det = dot(&e1, &pvec);
+        let ok_det = !det.abs().lt(L::splat(1e-20)) & 0xF;
+        let inv_det = L::splat(1.0).div(det);
+        let tvec = [o[0].sub(L::splat(v0.x)), o[1].sub(L::splat(v0.y)), o[2].sub(L::splat(v0.z))];
+        let u = dot(&tvec, &pvec).mul(inv_det);
+        let ok_u = L::splat(0.0).le(u) & u.le(L::splat(1.0));
+        let qvec = cross(&tvec, &e1);
+        let v = dot(&d, &qvec).mul(inv_det);
+        let miss_v = v.lt(L::splat(0.0)) | L::splat(1.0).lt(u.add(v));
+        let t = dot(&e2, &qvec).mul(inv_det);
+        let ok_t = L::splat(0.0).lt(t);
+        (ok_det & ok_u & !miss_v & ok_t & 0xF, t)
+    }
+}
+
+/// A deferred visit: child `slot` of node `node`, for the rays in `mask`.
+#[derive(Clone, Copy, Default)]
+struct Entry {
+    node: u32,
+    slot: u32,
+    mask: u64,
+}
+
+impl Bvh4 {
+    /// Traces the rays of `mask` in `packet` through the tree. `leaf(first,
+    /// count, mixed, rays, packet)` tests a leaf's primitives against the
+    /// rays `rays` (those that enter its box), updates their `tmax` and `id`
+    /// for a nearest-hit query, and returns the rays that are done (for an
+    /// any-hit query: blocked), which the traversal then drops. Children
+    /// are visited nearest first by the packet's interval bound.
+    pub fn packet<L: Lanes>(
+        &self,
+        packet: &mut Packet,
+        mask: u64,
+        mut leaf: impl FnMut(u32, u32, bool, u64, &mut Packet) -> u64,
+    ) {
+        let mut alive = mask & packet.all();
+        let mut stack = [Entry::default(); STACK_SIZE];
+        let mut top = 0;
+        // The root is an inner node whose children all rays may enter.
+        let mut expand = Some((0usize, alive));
+        loop {
+            if let Some((index, rays)) = expand.take() {
+                let node = &self.nodes[index];
+                let (bits, tnear) = packet.children::<L>(node);
+                // Push the farthest first, so that the nearest is popped first.
+                let mut order = [(0usize, 0.0f32); 4];
+                let mut n = 0;
+                let mut b = bits;
+                while b != 0 {
+                    let c = b.trailing_zeros() as usize;
+                    b &= b - 1;
+                    let mut i = n;
+                    while i > 0 && order[i - 1].1 < tnear[c] {
+                        order[i] = order[i - 1];
+                        i -= 1;
+                    }
+                    order[i] = (c, tnear[c]);
+                    n += 1;
+                }
+                for &(c, _) in &order[..n] {
+                    stack[top] = Entry { node: index as u32, slot: c as u32, mask: rays };
+                    top += 1;
+                }
+            }
+            if top == 0 || alive == 0 {
+                return;
+            }
+            top -= 1;
+            let e = stack[top];
+            let parent = &self.nodes[e.node as usize];
+            let slot = e.slot as usize;
+            let rays = packet.enter::<L>(parent, slot, e.mask & alive);
+            if rays == 0 {
+                continue;
+            }
+            let count = parent.count[slot];
+            if count != 0 {
+                alive &= !leaf(parent.child[slot], count & COUNT_MASK, count & LEAF_MIXED != 0, rays, packet);
+            } else {
+                expand = Some((parent.child[slot] as usize, rays));
+            }
+        }
+    }
+}
