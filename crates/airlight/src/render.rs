@@ -3,6 +3,7 @@
 //! is the same, bit for bit, whatever the thread count and however the
 //! samples were grouped (one render, progressive passes, shards).
 
+use crate::Rgb;
 use crate::film::{Accumulator, Image, PixelSum};
 use crate::integrator::{Integrator, IntegratorError};
 use crate::sampling::Sampler;
@@ -13,6 +14,27 @@ use std::ops::Range;
 use std::sync::atomic::{AtomicBool, Ordering};
 
 const TILE: u32 = 16;
+
+/// Side of the square blocks of pixels whose samples are traced together
+/// (see [`Integrator::radiance_batch`]).
+pub const BLOCK: u32 = 8;
+
+/// The pixels of a [`BLOCK`]×[`BLOCK`] block in Z order (Morton order: x
+/// and y bits interleaved), so that every 4 consecutive pixels form a 2×2
+/// square and every 16 a 4×4 one: the order in which packets of camera
+/// rays share the most work (`Geometry::intersect_packet`).
+pub const BLOCK_ORDER: [(u32, u32); (BLOCK * BLOCK) as usize] = {
+    let mut order = [(0, 0); (BLOCK * BLOCK) as usize];
+    let mut i = 0;
+    while i < order.len() {
+        let i32_ = i as u32;
+        let x = (i32_ & 1) | ((i32_ >> 1) & 2) | ((i32_ >> 2) & 4);
+        let y = ((i32_ >> 1) & 1) | ((i32_ >> 2) & 2) | ((i32_ >> 3) & 4);
+        order[i] = (x, y);
+        i += 1;
+    }
+    order
+};
 
 /// Hooks a caller may give a render: progress reports and a stop flag.
 #[derive(Default, Clone, Copy)]
@@ -81,12 +103,7 @@ pub fn accumulate(
             if observer.cancelled() {
                 return vec![PixelSum::default(); ((x1 - x0) * (y1 - y0)) as usize];
             }
-            let mut out = Vec::with_capacity(((x1 - x0) * (y1 - y0)) as usize);
-            for y in y0..y1 {
-                for x in x0..x1 {
-                    out.push(pixel_sum(scene, integrator, x, y, samples.clone()));
-                }
-            }
+            let out = tile_sums(scene, integrator, (x0, y0), (x1, y1), samples.clone());
             if let Some(progress) = observer.progress {
                 progress(out.len() as u64 * per_pixel);
             }
@@ -104,6 +121,47 @@ pub fn accumulate(
         }
     }
     acc
+}
+
+/// The summed samples `samples` of the pixels of the tile [x0, x1) × [y0,
+/// y1), row by row. The samples of each [`BLOCK`]×[`BLOCK`] block of pixels
+/// go to the integrator together, sample number by sample number, in
+/// [`BLOCK_ORDER`]; each pixel's sum is [`pixel_sum`]'s, bit for bit (the
+/// same samples, added in the same order).
+fn tile_sums(
+    scene: &Scene,
+    integrator: &dyn Integrator,
+    (x0, y0): (u32, u32),
+    (x1, y1): (u32, u32),
+    samples: Range<u64>,
+) -> Vec<PixelSum> {
+    let s = scene.settings();
+    let tile_w = x1 - x0;
+    let mut out = vec![PixelSum::default(); (tile_w * (y1 - y0)) as usize];
+    let n = BLOCK_ORDER.len();
+    let (mut pixels, mut rays, mut samplers) = (Vec::with_capacity(n), Vec::with_capacity(n), Vec::with_capacity(n));
+    let mut radiance = vec![Rgb::ZERO; n];
+    for by in (y0..y1).step_by(BLOCK as usize) {
+        for bx in (x0..x1).step_by(BLOCK as usize) {
+            pixels.clear();
+            pixels.extend(BLOCK_ORDER.iter().map(|&(dx, dy)| (bx + dx, by + dy)).filter(|&(x, y)| x < x1 && y < y1));
+            for i in samples.clone() {
+                rays.clear();
+                samplers.clear();
+                for &(x, y) in &pixels {
+                    let mut sampler = Sampler::for_pixel(s.seed, y as u64 * s.width as u64 + x as u64, i);
+                    rays.push(camera_ray(scene, integrator.stratified(), x, y, &mut sampler));
+                    samplers.push(sampler);
+                }
+                let radiance = &mut radiance[..pixels.len()];
+                integrator.radiance_batch(scene, &rays, &mut samplers, radiance);
+                for (&(x, y), r) in pixels.iter().zip(radiance.iter()) {
+                    out[((y - y0) * tile_w + (x - x0)) as usize].add(*r);
+                }
+            }
+        }
+    }
+    out
 }
 
 /// The samples `samples` of pixel (x, y), summed.

@@ -181,9 +181,9 @@ impl Geometry {
             return;
         }
         for i in first..first + count {
-            let [v0, e1, e2] = self.triangles[i as usize];
+            let triangle = &self.triangles[i as usize];
             for (s, lanes) in groups(rays) {
-                let (hit, t) = p.triangle4::<L>(s, v0, e1, e2);
+                let (hit, t) = p.triangle4::<L>(s, triangle);
                 let tmax = L::load(&p.tmax[s..]);
                 let candidates = hit & lanes & (t.lt(tmax) | t.eq(tmax));
                 if candidates == 0 {
@@ -215,9 +215,9 @@ impl Geometry {
             return blocked;
         }
         for i in first..first + count {
-            let [v0, e1, e2] = self.triangles[i as usize];
+            let triangle = &self.triangles[i as usize];
             for (s, lanes) in groups(rays & !blocked) {
-                let (hit, t) = p.triangle4::<L>(s, v0, e1, e2);
+                let (hit, t) = p.triangle4::<L>(s, triangle);
                 blocked |= ((hit & lanes & t.lt(L::load(&p.tmax[s..]))) as u64) << s;
             }
             if blocked == rays {

@@ -371,10 +371,13 @@ impl Packet {
     /// [`super::intersect_triangle`]: the mask of lanes with a hit at t > 0
     /// (no upper bound applied) and the lanes' t.
     #[inline(always)]
-    pub fn triangle4<L: Lanes>(&self, s: usize, v0: Vec3, e1: Vec3, e2: Vec3) -> (u32, L) {
+    pub fn triangle4<L: Lanes>(&self, s: usize, triangle: &[Vec3; 3]) -> (u32, L) {
         let d = [L::load(&self.dir[0][s..]), L::load(&self.dir[1][s..]), L::load(&self.dir[2][s..])];
         let o = [L::load(&self.origin[0][s..]), L::load(&self.origin[1][s..]), L::load(&self.origin[2][s..])];
-        let [e1, e2] = [e1, e2].map(|e| [L::splat(e.x), L::splat(e.y), L::splat(e.z)]);
+        // Each component read on its own: copying the 12-byte vectors whole
+        // and reloading them as 16 bytes stalled store forwarding.
+        let v0 = &triangle[0];
+        let [e1, e2] = [&triangle[1], &triangle[2]].map(|e| [L::splat(e.x), L::splat(e.y), L::splat(e.z)]);
         let cross = |a: &[L; 3], b: &[L; 3]| {
             [
                 a[1].mul(b[2]).sub(b[1].mul(a[2])),

@@ -1,4 +1,4 @@
-use super::{Integrator, first_surface, no_extra};
+use super::{Integrator, first_surface, first_surface_batch, no_extra};
 use crate::Rgb;
 use crate::geometry::Ray;
 use crate::sampling::Sampler;
@@ -10,5 +10,9 @@ pub struct Direct;
 impl Integrator for Direct {
     fn radiance(&self, scene: &Scene, ray: &Ray, sampler: &mut Sampler) -> Rgb {
         first_surface(scene, ray, sampler, None, no_extra).0
+    }
+
+    fn radiance_batch(&self, scene: &Scene, rays: &[Ray], samplers: &mut [Sampler], out: &mut [Rgb]) {
+        first_surface_batch(scene, rays, samplers, out)
     }
 }

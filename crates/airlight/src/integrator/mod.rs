@@ -4,6 +4,7 @@
 //! integrator` picks one.
 
 pub mod analytic;
+mod batch;
 mod direct;
 pub mod equiangular;
 mod options;
@@ -13,6 +14,7 @@ mod raymarch;
 mod stochastic;
 
 pub use analytic::{Analytic, AnalyticOptions};
+pub use batch::first_surface_batch;
 pub use direct::Direct;
 pub use equiangular::Equiangular;
 pub use options::{
@@ -53,6 +55,18 @@ pub trait Integrator: Send + Sync {
     fn radiance_parts(&self, scene: &Scene, ray: &Ray, sampler: &mut Sampler) -> Option<RadianceParts> {
         let _ = (scene, ray, sampler);
         None
+    }
+
+    /// Radiance along many camera rays, each with its own sampler:
+    /// `out[i]` is `self.radiance(scene, &rays[i], &mut samplers[i])`, bit
+    /// for bit. The render loop hands over the samples of a block of
+    /// neighbouring pixels, so that integrators may trace their coherent
+    /// rays together (see `Geometry::intersect_packet`); by default, one
+    /// sample after another.
+    fn radiance_batch(&self, scene: &Scene, rays: &[Ray], samplers: &mut [Sampler], out: &mut [Rgb]) {
+        for ((ray, sampler), out) in rays.iter().zip(samplers.iter_mut()).zip(out.iter_mut()) {
+            *out = self.radiance(scene, ray, sampler);
+        }
     }
 
     /// The scene's lights changed ([`Scene::set_lights`], [`Scene::at_time`]):
@@ -227,6 +241,8 @@ pub fn no_extra(_: &SurfaceHit) -> Rgb {
 /// Radiance leaving a surface toward `-ray.dir`: its emission plus direct
 /// light from every light, one sample per area light, with shadow rays. In a
 /// medium, light arriving from each light is attenuated on its way.
+/// (`batch.rs` computes the same without a medium for many rays at once:
+/// a change here must be made there too; the render tests compare them.)
 pub fn surface_radiance(
     scene: &Scene,
     ray: &Ray,

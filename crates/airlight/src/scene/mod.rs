@@ -36,7 +36,7 @@ pub use lights::LightCulling;
 use crate::Rgb;
 use crate::camera::Camera;
 use crate::film::Tonemap;
-use crate::geometry::{Geometry, GeometryBuilder, Shape, SurfaceHit, offset_origin};
+use crate::geometry::{Geometry, GeometryBuilder, Segment, Shape, SurfaceHit, offset_origin};
 use crate::light::{Keyframes, Light, LightSample, third_dimension};
 use crate::material::Material;
 use crate::medium::Medium;
@@ -368,13 +368,22 @@ impl Scene {
     /// of itself (the Cornell box's one-bounce walls read 5.5% dark so).
     #[inline]
     pub fn light_visible(&self, p: Vec3, origin: Vec3, wi: Vec3, distance: f32) -> bool {
+        self.light_segment(p, origin, wi, distance).is_some_and(|s| !self.geometry.occluded(s.origin, s.dir, s.tmax))
+    }
+
+    /// The shadow ray that [`Scene::light_visible`] traces, or None where
+    /// it traces none and answers "not visible" (the sample point is the
+    /// origin itself): for callers that trace many at once
+    /// ([`Geometry::occluded_packet`]).
+    #[inline]
+    pub fn light_segment(&self, p: Vec3, origin: Vec3, wi: Vec3, distance: f32) -> Option<Segment> {
         const SHORT: f32 = 1.0 - 1e-4;
         if !distance.is_finite() {
-            return !self.geometry.occluded(origin, wi, 2.0 * self.bounds_radius * SHORT);
+            return Some(Segment { origin, dir: wi, tmax: 2.0 * self.bounds_radius * SHORT });
         }
         let to = p + wi * distance - origin;
         let length = to.length();
-        length > 0.0 && !self.geometry.occluded(origin, to / length, length * SHORT)
+        (length > 0.0).then(|| Segment { origin, dir: to / length, tmax: length * SHORT })
     }
 
     /// Calls `f(index, light)` for every light that may reach `p`, in index
