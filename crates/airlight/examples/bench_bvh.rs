@@ -93,9 +93,8 @@ fn main() {
         .collect();
 
     let primary = |rays: &[Ray]| rays.iter().map(|ray| geometry.intersect(ray, f32::INFINITY).is_some() as u64).sum();
-    let occluded = |segments: &[Segment]| {
-        segments.iter().map(|s| geometry.occluded(s.origin, s.dir, s.tmax) as u64).sum()
-    };
+    let occluded =
+        |segments: &[Segment]| segments.iter().map(|s| geometry.occluded(s.origin, s.dir, s.tmax) as u64).sum();
     let primary_packet = |rays: &[Ray]| {
         let mut hits = [None; CHUNK];
         let hits = &mut hits[..rays.len()];

@@ -4,8 +4,8 @@
 //! are tested one by one.
 
 use super::Ray;
-use super::bvh4::{self, BoxRay, Bvh4};
 use super::batch::{comes_before, test_bound};
+use super::bvh4::{self, BoxRay, Bvh4};
 use super::sdf::{Sdf, sphere_trace};
 use super::shape::{Shape, box_normal, intersect_box, intersect_quad, intersect_sphere, intersect_triangle};
 use glam::{Affine3A, Mat3, Vec2, Vec3, Vec3A};

@@ -92,31 +92,36 @@ impl Geometry {
             return;
         };
         let mut packet: Option<Box<Packet>> = None;
-        for_each_packet(rays.len(), |i| rays[i].dir, |indices| {
-            if indices.len() < MIN_PACKET {
-                for &i in indices {
-                    hits[i] = self.intersect(&rays[i], tmax);
+        for_each_packet(
+            rays.len(),
+            |i| rays[i].dir,
+            |indices| {
+                if indices.len() < MIN_PACKET {
+                    for &i in indices {
+                        hits[i] = self.intersect(&rays[i], tmax);
+                    }
+                    return;
                 }
-                return;
-            }
-            let items = indices.iter().map(|&i| (rays[i].origin, rays[i].dir, tmax));
-            let p = match &mut packet {
-                Some(p) => {
-                    p.fill(items);
-                    p
+                let items = indices.iter().map(|&i| (rays[i].origin, rays[i].dir, tmax));
+                let p = match &mut packet {
+                    Some(p) => {
+                        p.fill(items);
+                        p
+                    }
+                    None => packet.insert(Packet::new(items)),
+                };
+                let leaf = |first, count, mixed, rays, p: &mut Packet| {
+                    self.packet_leaf_closest::<L>(first, count, mixed, rays, p);
+                    0
+                };
+                bvh.packet::<L>(p, p.all(), leaf, |first, count| self.prefetch_triangles(first, count));
+                for (k, &i) in indices.iter().enumerate() {
+                    let mut best = Hit { t: p.tmax[k], id: p.id[k] };
+                    self.intersect_unbounded(&rays[i], &mut best);
+                    hits[i] = (best.id != u32::MAX).then_some(best);
                 }
-                None => packet.insert(Packet::new(items)),
-            };
-            bvh.packet::<L>(p, p.all(), |first, count, mixed, rays, p| {
-                self.packet_leaf_closest::<L>(first, count, mixed, rays, p);
-                0
-            });
-            for (k, &i) in indices.iter().enumerate() {
-                let mut best = Hit { t: p.tmax[k], id: p.id[k] };
-                self.intersect_unbounded(&rays[i], &mut best);
-                hits[i] = (best.id != u32::MAX).then_some(best);
-            }
-        });
+            },
+        );
     }
 
     fn occluded_packet_with<L: Lanes>(&self, segments: &[Segment], blocked: &mut [bool]) {
@@ -132,34 +137,50 @@ impl Geometry {
             return;
         };
         let mut packet: Option<Box<Packet>> = None;
-        for_each_packet(segments.len(), |i| segments[i].dir, |indices| {
-            if indices.len() < MIN_PACKET {
-                for &i in indices {
-                    let s = &segments[i];
-                    blocked[i] = blocked[i] || self.occluded_bvh(bvh, s.origin, s.dir, s.tmax);
+        for_each_packet(
+            segments.len(),
+            |i| segments[i].dir,
+            |indices| {
+                if indices.len() < MIN_PACKET {
+                    for &i in indices {
+                        let s = &segments[i];
+                        blocked[i] = blocked[i] || self.occluded_bvh(bvh, s.origin, s.dir, s.tmax);
+                    }
+                    return;
                 }
-                return;
-            }
-            let items = indices.iter().map(|&i| (segments[i].origin, segments[i].dir, segments[i].tmax));
-            let p = match &mut packet {
-                Some(p) => {
-                    p.fill(items);
-                    p
+                let items = indices.iter().map(|&i| (segments[i].origin, segments[i].dir, segments[i].tmax));
+                let p = match &mut packet {
+                    Some(p) => {
+                        p.fill(items);
+                        p
+                    }
+                    None => packet.insert(Packet::new(items)),
+                };
+                // Rays already blocked by a plane need no traversal.
+                let open = indices.iter().enumerate().fold(0u64, |m, (k, &i)| m | ((!blocked[i] as u64) << k));
+                let mut found = 0u64;
+                let leaf = |first, count, mixed, rays, p: &mut Packet| {
+                    let b = self.packet_leaf_any::<L>(first, count, mixed, rays, p);
+                    found |= b;
+                    b
+                };
+                bvh.packet::<L>(p, open, leaf, |first, count| self.prefetch_triangles(first, count));
+                for (k, &i) in indices.iter().enumerate() {
+                    blocked[i] |= found & (1 << k) != 0;
                 }
-                None => packet.insert(Packet::new(items)),
-            };
-            // Rays already blocked by a plane need no traversal.
-            let open = indices.iter().enumerate().fold(0u64, |m, (k, &i)| m | ((!blocked[i] as u64) << k));
-            let mut found = 0u64;
-            bvh.packet::<L>(p, open, |first, count, mixed, rays, p| {
-                let b = self.packet_leaf_any::<L>(first, count, mixed, rays, p);
-                found |= b;
-                b
-            });
-            for (k, &i) in indices.iter().enumerate() {
-                blocked[i] |= found & (1 << k) != 0;
+            },
+        );
+    }
+
+    /// Starts fetching the compact copies of triangles `first .. first + count`.
+    #[inline(always)]
+    fn prefetch_triangles(&self, first: u32, count: u32) {
+        if let Some(t) = self.triangles.get(first as usize..(first + count) as usize) {
+            super::packet::prefetch(&t[0]);
+            if let Some(last) = t.last() {
+                super::packet::prefetch(last);
             }
-        });
+        }
     }
 
     /// A leaf of a nearest-hit packet query: tests primitives `first ..
@@ -226,7 +247,6 @@ impl Geometry {
         }
         blocked
     }
-
 }
 
 /// Whether a hit at `t` on primitive `id` comes before the best so far,
@@ -245,7 +265,22 @@ pub(super) fn comes_before(t: f32, id: u32, best_t: f32, best_id: u32) -> bool {
 /// same distance is reported (primitive tests take an open bound).
 #[inline(always)]
 pub(super) fn test_bound(best_t: f32, best_id: u32) -> f32 {
-    if best_id == u32::MAX { best_t } else { best_t.next_up() }
+    if best_id == u32::MAX { best_t } else { next_up(best_t) }
+}
+
+/// The least f32 above `x` (`f32::next_up`, which needs a newer Rust than
+/// the crate's minimum).
+#[inline(always)]
+fn next_up(x: f32) -> f32 {
+    if x.is_nan() || x == f32::INFINITY {
+        x
+    } else if x == 0.0 {
+        f32::from_bits(1)
+    } else if x > 0.0 {
+        f32::from_bits(x.to_bits() + 1)
+    } else {
+        f32::from_bits(x.to_bits() - 1)
+    }
 }
 
 /// The set bits of a mask, lowest first.
@@ -274,3 +309,22 @@ pub(super) fn groups(mut mask: u64) -> impl Iterator<Item = (usize, u32)> {
     })
 }
 
+#[cfg(test)]
+mod tests {
+    use super::next_up;
+
+    #[test]
+    fn next_up_is_the_least_float_above() {
+        assert_eq!(next_up(1.0), 1.0 + f32::EPSILON);
+        assert_eq!(next_up(-1.0), -(1.0 - f32::EPSILON / 2.0));
+        assert_eq!(next_up(0.0), f32::from_bits(1));
+        assert_eq!(next_up(-0.0), f32::from_bits(1));
+        assert_eq!(next_up(f32::MAX), f32::INFINITY);
+        assert_eq!(next_up(f32::INFINITY), f32::INFINITY);
+        assert!(next_up(f32::NAN).is_nan());
+        for x in [3.7e-3f32, 12.5, 1e30] {
+            let y = next_up(x);
+            assert!(y > x && ((x + y) / 2.0 == x || (x + y) / 2.0 == y), "{x}");
+        }
+    }
+}

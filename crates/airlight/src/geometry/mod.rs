@@ -8,8 +8,8 @@ mod ray;
 pub mod sdf;
 mod shape;
 
-pub use batch::Segment;
 pub use accel::{Geometry, GeometryBuilder, Hit, SurfaceHit, shadow_rays_traced};
+pub use batch::Segment;
 pub use ray::{Ray, offset_origin};
 pub use sdf::Sdf;
 pub use shape::{Shape, intersect_box, intersect_quad, intersect_sphere, intersect_triangle};
