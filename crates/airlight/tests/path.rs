@@ -188,7 +188,7 @@ fn equiangular_light_sampling_lowers_the_error_near_lights() {
     let marched =
         render(&in_view(16), &Raymarch::new(RaymarchOptions { steps: 4096, jitter: true }), &RenderObserver::none());
     let error = |equiangular| {
-        let tracer = PathTracer { max_depth: 1, equiangular, closed_form: true };
+        let tracer = PathTracer { max_depth: 1, equiangular, closed_form: true, stratify: true };
         compare(&render(&in_view(64), &tracer, &RenderObserver::none()), &marched).unwrap().rel_rmse
     };
     let (free_flight, with_equiangular) = (error(false), error(true));

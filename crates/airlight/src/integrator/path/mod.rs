@@ -15,6 +15,7 @@ pub mod tracking;
 use super::{Integrator, PathOptions};
 use crate::Rgb;
 use crate::geometry::{Ray, offset_origin};
+use crate::material::Material;
 use crate::medium::{henyey_greenstein, sample_henyey_greenstein_cos};
 use crate::sampling::{Sampler, to_world};
 use crate::scene::Scene;
@@ -74,8 +75,16 @@ pub(super) struct Bounce {
 /// Where light scatters: a surface or a point in the medium (with its
 /// place on an equiangularly sampled segment, if any).
 enum Vertex<'a> {
-    Surface { p: Vec3, n: Vec3, material: u32 },
-    Medium { p: Vec3, along: Option<Along<'a>> },
+    /// `material` as it is at the hit (a texture looked up).
+    Surface {
+        p: Vec3,
+        n: Vec3,
+        material: &'a Material,
+    },
+    Medium {
+        p: Vec3,
+        along: Option<Along<'a>>,
+    },
 }
 
 impl Vertex<'_> {
@@ -226,7 +235,7 @@ impl Integrator for PathTracer {
             let numbers = self.bounce(depth, sampler);
             let material = scene.material_at(&surface);
             let wo = -ray.dir;
-            let vertex = Vertex::Surface { p: surface.p, n: surface.n, material: surface.material };
+            let vertex = Vertex::Surface { p: surface.p, n: surface.n, material: &material };
             let fog = Fog { medium, closed_form: self.closed_form };
             l += beta * direct_light(scene, fog, &vertex, wo, r_u, hero, numbers.light, sampler);
             let Some(bs) = material.sample(surface.p, surface.n, wo, numbers.direction, sampler.next()) else {

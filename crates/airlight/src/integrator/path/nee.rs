@@ -173,10 +173,9 @@ pub(super) fn direct_light(
         };
         let Some(ls) = scene.sample_light(index, p, light_numbers(u)) else { return };
         let (f, scatter_pdf, normal) = match *vertex {
-            Vertex::Surface { p, n, material } => {
-                let m = scene.material(material);
-                let f = m.brdf(p, n, wo, ls.wi) * ls.wi.dot(n).abs();
-                (f, m.pdf(p, n, wo, ls.wi), Some(n))
+            Vertex::Surface { p, n, material: m } => {
+                let (brdf, pdf) = m.eval(p, n, wo, ls.wi);
+                (brdf * ls.wi.dot(n).abs(), pdf, Some(n))
             }
             Vertex::Medium { .. } => {
                 let phase = medium.map_or(0.0, |m| m.phase(wo, ls.wi));
