@@ -143,11 +143,10 @@ const fn nibble_tables() -> [[[u32; 16]; 8]; 3] {
 pub fn scrambled_sobol4(index: u32, seed: u32) -> [f32; 4] {
     let shuffled = owen_scramble(index, seed);
     let mut reversed = [shuffled, 0, 0, 0];
-    for j in 0..8 {
-        let nibble = ((shuffled >> (4 * j)) & 15) as usize;
-        reversed[1] ^= NIBBLES[0][j][nibble];
-        reversed[2] ^= NIBBLES[1][j][nibble];
-        reversed[3] ^= NIBBLES[2][j][nibble];
+    for (value, table) in reversed[1..].iter_mut().zip(&NIBBLES) {
+        for (j, row) in table.iter().enumerate() {
+            *value ^= row[((shuffled >> (4 * j)) & 15) as usize];
+        }
     }
     let mut out = [0.0; 4];
     for (d, slot) in out.iter_mut().enumerate() {

@@ -76,11 +76,13 @@ pub(super) struct Bounce {
 /// Where light scatters: a surface or a point in the medium (with its
 /// place on an equiangularly sampled segment, if any).
 enum Vertex<'a> {
-    /// `material` as it is at the hit (a texture looked up).
+    /// `material` as it is at the hit (a texture looked up);
+    /// `light_numbers`, if stratified, the light samples' numbers.
     Surface {
         p: Vec3,
         n: Vec3,
         material: &'a Material,
+        light_numbers: Option<Vec2>,
     },
     Medium {
         p: Vec3,
@@ -149,7 +151,7 @@ impl Integrator for PathTracer {
                         // rare fireflies (2 of 8 renders at 128 spp had a
                         // pixel 5–8× the brightest of independent renders),
                         // whose cause is not yet understood.
-                        let numbers = Bounce { light: None, direction: sampler.next2() };
+                        let direction = sampler.next2();
                         let pdf = c.t_maj[hero] * c.sigma_s[hero];
                         let along = equiangular.then(|| Along { segment: &segment, t: c.t, r_equiangular: r_u / pdf });
                         beta *= c.t_maj * c.sigma_s / pdf;
@@ -169,13 +171,12 @@ impl Integrator for PathTracer {
                                 wo,
                                 r_u,
                                 hero,
-                                numbers.light,
                                 sampler,
                             );
                         // Phase sampling: its weight p/pdf is 1.
-                        let cos = sample_henyey_greenstein_cos(m.g, numbers.direction.x);
+                        let cos = sample_henyey_greenstein_cos(m.g, direction.x);
                         let sin = (1.0 - cos * cos).max(0.0).sqrt();
-                        let phi = 2.0 * std::f32::consts::PI * numbers.direction.y;
+                        let phi = 2.0 * std::f32::consts::PI * direction.y;
                         let wi = to_world(Vec3::new(sin * phi.cos(), sin * phi.sin(), cos), wo);
                         r_l = r_u / henyey_greenstein(cos, m.g);
                         prev_p = p;
@@ -241,9 +242,10 @@ impl Integrator for PathTracer {
             let numbers = self.bounce(depth, sampler);
             let material = scene.material_at(&surface);
             let wo = -ray.dir;
-            let vertex = Vertex::Surface { p: surface.p, n: surface.n, material: &material };
+            let vertex =
+                Vertex::Surface { p: surface.p, n: surface.n, material: &material, light_numbers: numbers.light };
             let fog = Fog { medium, closed_form: self.closed_form };
-            l += beta * direct_light(scene, fog, &vertex, wo, r_u, hero, numbers.light, sampler);
+            l += beta * direct_light(scene, fog, &vertex, wo, r_u, hero, sampler);
             let Some(bs) = material.sample(surface.p, surface.n, wo, numbers.direction, sampler.next()) else {
                 return l;
             };

@@ -33,7 +33,7 @@ use crate::medium::Medium;
 use crate::sampling::{Sampler, keyed2};
 use crate::scene::Scene;
 use crate::scene::light_numbers;
-use glam::{Vec2, Vec3};
+use glam::Vec3;
 
 /// A ray's stretch [0, length] through a medium with a closed-form
 /// optical depth.
@@ -150,10 +150,13 @@ pub(super) fn direct_light(
     wo: Vec3,
     r_p: Rgb,
     hero: usize,
-    stratified: Option<Vec2>,
     sampler: &mut Sampler,
 ) -> Rgb {
     let p = vertex.p();
+    let stratified = match *vertex {
+        Vertex::Surface { light_numbers, .. } => light_numbers,
+        Vertex::Medium { .. } => None,
+    };
     let medium = fog.medium;
     let along = match vertex {
         Vertex::Medium { along, .. } => along.as_ref(),
@@ -173,7 +176,7 @@ pub(super) fn direct_light(
         };
         let Some(ls) = scene.sample_light(index, p, light_numbers(u)) else { return };
         let (f, scatter_pdf, normal) = match *vertex {
-            Vertex::Surface { p, n, material: m } => {
+            Vertex::Surface { p, n, material: m, .. } => {
                 let (brdf, pdf) = m.eval(p, n, wo, ls.wi);
                 (brdf * ls.wi.dot(n).abs(), pdf, Some(n))
             }
