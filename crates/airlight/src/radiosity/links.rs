@@ -424,12 +424,14 @@ impl Context<'_> {
     }
 
     /// The patch under node `node` whose area interval holds the fraction
-    /// `u` of the node's area.
+    /// `u` of the node's area: the first i in start..end with
+    /// cdf[i + 1] > target (the last when none is). Searched from the
+    /// index that equal areas would give, stepping to the answer: a
+    /// cluster's patches have nearly equal areas, so this takes a step or
+    /// two where a binary search over a large cluster took twenty cache
+    /// misses (it was the costliest part of compiling at 100k patches).
     fn pick(&self, node: &Node, u: f64) -> usize {
-        let (lo, hi) = (self.cdf[node.start as usize], self.cdf[node.end as usize]);
-        let target = lo + u * (hi - lo);
-        let range = &self.cdf[node.start as usize + 1..=node.end as usize];
-        (node.start as usize + range.partition_point(|&x| x <= target)).min(node.end as usize - 1)
+        pick(self.cdf, node.start as usize, node.end as usize, u)
     }
 
     /// A_s · (1/M) Σ_m G(x_m, y_m) V(x_m, y_m), x_m and y_m patch centres
@@ -455,6 +457,22 @@ impl Context<'_> {
     }
 }
 
+/// See [`Context::pick`]: the patch in start..end (start < end) whose
+/// interval of the prefix sums `cdf` holds the fraction `u` of their span.
+fn pick(cdf: &[f64], start: usize, end: usize, u: f64) -> usize {
+    let (lo, hi) = (cdf[start], cdf[end]);
+    let target = lo + u * (hi - lo);
+    let guess = start + ((u * (end - start) as f64) as usize);
+    let mut i = guess.clamp(start, end - 1);
+    while i > start && cdf[i] > target {
+        i -= 1;
+    }
+    while i < end - 1 && cdf[i + 1] <= target {
+        i += 1;
+    }
+    i
+}
+
 /// Whether every point of `b` lies behind (or on) every patch of `a`:
 /// n_x · (y − x) ≤ 0 for all patches x of a with normal n_x and points y of
 /// b. Bounded by n̄·(c_b − c_a) + (b's extent along n̄) + a's half
@@ -473,6 +491,28 @@ mod tests {
     use super::*;
     use crate::SceneFile;
     use crate::radiosity::{CompileParams, hierarchy, patches};
+
+    /// The stepping search finds what a binary search finds, with unequal
+    /// and zero areas.
+    #[test]
+    fn pick_is_the_binary_search() {
+        let mut cdf = vec![0.0f64];
+        for k in 0..200u64 {
+            let area = [0.0, 1.0, 0.25, 7.0, 0.0, 0.5][(hierarchy::mix(k) % 6) as usize];
+            cdf.push(cdf.last().unwrap() + area);
+        }
+        let binary = |start: usize, end: usize, u: f64| {
+            let target = cdf[start] + u * (cdf[end] - cdf[start]);
+            let range = &cdf[start + 1..=end];
+            (start + range.partition_point(|&x| x <= target)).min(end - 1)
+        };
+        for (start, end) in [(0, 200), (3, 4), (10, 90), (150, 152), (0, 1)] {
+            for k in 0..=1000 {
+                let u = k as f64 / 1000.0 * 0.999_999;
+                assert_eq!(pick(&cdf, start, end, u), binary(start, end, u), "{start}..{end}, u {u}");
+            }
+        }
+    }
 
     /// Links made block by block are those of one refinement over all
     /// receivers, with patches and with clusters receiving.
