@@ -47,14 +47,16 @@ use patches::Patch;
 use rayon::prelude::*;
 use std::time::{Duration, Instant};
 
-/// Most patches a scene may be cut into (about 2 GB of links at the
-/// default threshold; see docs/radiosity-bench.md).
+/// Most patches a scene may be cut into (about 4 GB of links with patches
+/// alone receiving at the default threshold; see docs/radiosity-bench.md).
 pub const MAX_PATCHES: usize = 2_000_000;
 
-/// Peak bytes of compilation per patch (links collected before packing;
-/// 753 MB at 100,451 patches in docs/radiosity-bench.md), for the
-/// up-front memory check.
-pub const PEAK_BYTES_PER_PATCH: u64 = 8 << 10;
+/// Peak bytes of compilation per patch, for the up-front memory check,
+/// with patches alone receiving (the most links): ~340 packed links of 6
+/// bytes, patch and cluster records, and one block's unpacked links
+/// (docs/radiosity-bench.md). Clusters receiving at
+/// [`LARGE_RECEIVER_SHARE`] peak at a fifth of this (554 MB at 1M patches).
+pub const PEAK_BYTES_PER_PATCH: u64 = 4 << 10;
 
 /// Scenes estimated to cut into more patches than this (both sides of
 /// boxes counted, before culling) let clusters receive by default, with
