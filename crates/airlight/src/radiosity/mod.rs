@@ -112,9 +112,11 @@ pub struct CompileParams {
     /// Clusters may receive light too (Hanrahan, Salzman and Aupperle's
     /// two-sided refinement) when flat (normals within ~18°) and their own
     /// estimated form factor is below `receiver_share × link_threshold`; the
-    /// irradiance a cluster gathers is handed down to its patches. 0 (the
-    /// default) lets only patches receive, as Madams does: on the Cornell
-    /// box receiver clusters saved fewer links than they cost in accuracy.
+    /// irradiance a cluster gathers is handed down to its patches. 0 lets
+    /// only patches receive, as Madams does: the default up to
+    /// [`RECEIVER_CLUSTERS_FROM`] patches, where receiver clusters save
+    /// fewer links than they cost in accuracy; larger scenes default to
+    /// [`LARGE_RECEIVER_SHARE`].
     pub receiver_share: f32,
     /// Seeds the clustering and the sample positions.
     pub seed: u64,
