@@ -194,8 +194,9 @@ pub struct Radiosity {
     materials: Vec<Material>,
     direct: Vec<Rgb>,
     indirect: Vec<Rgb>,
-    /// Per node (patches, then clusters): radiosity (16-byte aligned for
-    /// the gather's SIMD).
+    /// Per node (patches, then clusters): area, for pushing radiosity up.
+    node_area: Vec<f32>,
+    /// Per node: radiosity (16-byte aligned for the gather's SIMD).
     node_b: Vec<glam::Vec3A>,
     /// Per node: one bounce's gathered irradiance.
     gathered: Vec<Rgb>,
@@ -275,6 +276,7 @@ impl Radiosity {
             materials: Vec::new(),
             direct: vec![Rgb::ZERO; n],
             indirect: vec![Rgb::ZERO; n],
+            node_area: patches.iter().map(|p| p.area).chain(hierarchy.clusters.iter().map(|c| c.area)).collect(),
             node_b: vec![glam::Vec3A::ZERO; nodes],
             gathered: vec![Rgb::ZERO; nodes],
             patches,
@@ -302,7 +304,8 @@ impl Radiosity {
         let per_patch = self.patches.capacity() * size_of::<Patch>()
             + (self.albedo.capacity() + self.direct.capacity() + self.indirect.capacity() + self.gathered.capacity())
                 * size_of::<Rgb>()
-            + self.node_b.capacity() * size_of::<glam::Vec3A>();
+            + self.node_b.capacity() * size_of::<glam::Vec3A>()
+            + self.node_area.capacity() * size_of::<f32>();
         per_patch + self.hierarchy.bytes() + self.links.bytes() + self.lookup.bytes()
     }
 
@@ -332,7 +335,7 @@ impl Radiosity {
             for ((b, a), e) in self.node_b[..n].iter_mut().zip(&self.albedo).zip(source) {
                 *b = (*a * *e).into();
             }
-            lighting::push(&self.patches, &self.hierarchy, &mut self.node_b);
+            lighting::push(&self.node_area, &self.hierarchy, &mut self.node_b);
             times.push += t.elapsed();
             let t = Instant::now();
             lighting::gather(&self.links, &self.node_b, &mut self.gathered);
