@@ -19,7 +19,6 @@ use crate::sampling::Sampler;
 use crate::scene::{PixelFilter, Scene};
 use glam::Vec2;
 use rayon::prelude::*;
-use std::cell::RefCell;
 use std::f32::consts::FRAC_1_PI;
 
 /// One pixel's camera ray and what it meets among the objects.
@@ -112,7 +111,7 @@ impl FirstSample {
                         if let Some(solution) = solution {
                             let n = if surface.n.dot(ray.dir) <= 0.0 { surface.n } else { -surface.n };
                             texel.start = weights.len() as u32;
-                            if let Some(scale) = lookup_weights(solution, surface.p, n, &mut weights) {
+                            if let Some(scale) = solution.lookup().weights(solution.patches(), surface.p, n, &mut weights) {
                                 texel.len = weights.len() as u32 - texel.start;
                                 texel.scale = scale;
                             }
@@ -198,70 +197,6 @@ fn light_surfaces(scene: &Scene) -> Geometry {
     g.build()
 }
 
-/// One term, or the running sum, of the lookup's kernel average, run over
-/// this type instead of over colours to learn the lookup's patches and
-/// weights, whatever its kernel. The lookup computes
-/// (Σᵢ value(i)·wᵢ)·(1/Σ wᵢ): a single `value(i)` times a weight keeps the
-/// weight, adding it to the sum appends (patch, weight) to `sink`, and a
-/// factor on the sum is the final normalisation, kept in `scale`. Small and
-/// `Copy`, so the lookup's by-value arithmetic costs nothing.
-#[derive(Clone, Copy)]
-struct Term<'a> {
-    sink: Option<&'a RefCell<Vec<(u32, f32)>>>,
-    /// A single term's patch and weight (before it joins the sum).
-    single: Option<(u32, f32)>,
-    scale: f32,
-}
-
-impl Default for Term<'_> {
-    /// The empty sum.
-    fn default() -> Self {
-        Term { sink: None, single: None, scale: 1.0 }
-    }
-}
-
-impl std::ops::Mul<f32> for Term<'_> {
-    type Output = Self;
-    fn mul(mut self, f: f32) -> Self {
-        match &mut self.single {
-            Some((_, w)) => *w *= f,
-            None => self.scale *= f,
-        }
-        self
-    }
-}
-
-impl std::ops::Add for Term<'_> {
-    type Output = Self;
-    fn add(self, other: Self) -> Self {
-        let sink = self.sink.or(other.sink);
-        if let (Some(sink), Some(item)) = (sink, other.single) {
-            sink.borrow_mut().push(item);
-        }
-        Term { sink, single: None, scale: self.scale }
-    }
-}
-
-/// Appends the lookup's (patch, weight) pairs at `p` to `out` and returns
-/// the normalisation factor, or None (nothing appended) where no patch is near.
-fn lookup_weights(solution: &Radiosity, p: glam::Vec3, n: glam::Vec3, out: &mut Vec<(u32, f32)>) -> Option<f32> {
-    let sink = RefCell::new(std::mem::take(out));
-    let before = sink.borrow().len();
-    let scale = solution
-        .lookup()
-        .interpolate(solution.patches(), p, n, |i| Term {
-            sink: Some(&sink),
-            single: Some((i as u32, 1.0)),
-            scale: 1.0,
-        })
-        .map(|t| t.scale);
-    *out = sink.into_inner();
-    if scale.is_none() {
-        out.truncate(before);
-    }
-    scale
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -310,14 +245,5 @@ mod tests {
     fn in_a_medium_too() {
         let text = format!("{CORNELL}\n[medium]\nsigma_a = 0.01\nsigma_s = 0.03\n");
         check(&mut SceneFile::from_toml_str(&text, None).unwrap().scene);
-    }
-
-    #[test]
-    fn terms_follow_the_lookups_sum_and_normalisation() {
-        let sink = RefCell::new(Vec::new());
-        let one = |i: u32| Term { sink: Some(&sink), single: Some((i, 1.0)), scale: 1.0 };
-        let sum = (Term::default() + one(3) * 0.5 + one(7) * 0.25) * 4.0;
-        assert_eq!(sum.scale, 4.0);
-        assert_eq!(sink.borrow().as_slice(), &[(3, 0.5), (7, 0.25)]);
     }
 }
