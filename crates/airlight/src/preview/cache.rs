@@ -30,14 +30,11 @@ struct Texel {
     t: f32,
     /// The diffuse albedo at the hit, times 1/π.
     albedo: Rgb,
-    /// Lookup weights: `weights[start..start + len]`, times `scale`.
+    /// Lookup weights: `weights[row][start..start + len]`, times `scale`.
     start: u32,
     len: u32,
     scale: f32,
 }
-
-/// One image row's texels and the lookup weights they index.
-type Row = (Vec<Texel>, Vec<(u32, f32)>);
 
 /// What [`Camera`], size, seed and filter the cache was made for.
 type Key = (Camera, u32, u32, u64, PixelFilter);
@@ -49,7 +46,10 @@ pub struct FirstSample {
     /// The scene's objects without the lights' surfaces.
     objects: Geometry,
     texels: Vec<Texel>,
-    weights: Vec<(u32, f32)>,
+    /// Per image row, the lookup weights its texels index. Kept, with the
+    /// texels, from frame to frame: a moving camera refills them every
+    /// frame, into the memory the last frame used.
+    weights: Vec<Vec<(u32, f32)>>,
 }
 
 impl FirstSample {
@@ -75,10 +75,9 @@ impl FirstSample {
         let lights = light_surfaces(scene);
         let (w, h) = (scene.settings().width, scene.settings().height);
         let mut image = Image::new(w, h);
-        image.pixels.par_chunks_mut(w as usize).enumerate().for_each(|(y, row)| {
+        image.pixels.par_chunks_mut(w.max(1) as usize).enumerate().for_each(|(y, row)| {
             for (x, out) in row.iter_mut().enumerate() {
-                let index = y * w as usize + x;
-                *out = self.shade(scene, solution, preview, &lights, index);
+                *out = self.shade(scene, solution, preview, &lights, y, y * w as usize + x);
             }
         });
         image
@@ -87,12 +86,17 @@ impl FirstSample {
     fn fill(&mut self, scene: &Scene, solution: Option<&Radiosity>) {
         let s = scene.settings();
         let (w, h) = (s.width as usize, s.height as usize);
-        let rows: Vec<Row> = (0..h)
-            .into_par_iter()
-            .map(|y| {
-                let mut texels = Vec::with_capacity(w);
-                let mut weights = Vec::new();
-                for x in 0..w {
+        if self.texels.len() != w * h {
+            let ray = Ray::new(glam::Vec3::ZERO, glam::Vec3::Z);
+            let empty = Texel { ray, hit: None, t: 0.0, albedo: Rgb::ZERO, start: 0, len: 0, scale: 0.0 };
+            self.texels = vec![empty; w * h];
+        }
+        self.weights.resize_with(h, Vec::new);
+        let objects = &self.objects;
+        self.texels.par_chunks_mut(w.max(1)).zip(self.weights.par_iter_mut()).enumerate().for_each(
+            |(y, (texels, weights))| {
+                weights.clear();
+                for (x, texel) in texels.iter_mut().enumerate() {
                     let mut sampler = first_sampler(scene, (y * w + x) as u64);
                     let (jitter, lens) = (sampler.next2(), sampler.next2());
                     let film = Vec2::new(x as f32, y as f32)
@@ -102,33 +106,25 @@ impl FirstSample {
                         };
                     let ray = scene.camera().ray(film, s.width, s.height, lens);
                     let t = f32::INFINITY;
-                    let mut texel = Texel { ray, hit: None, t, albedo: Rgb::ZERO, start: 0, len: 0, scale: 0.0 };
-                    if let Some(hit) = self.objects.intersect(&ray, t) {
-                        let surface = self.objects.surface(&ray, hit);
+                    *texel = Texel { ray, hit: None, t, albedo: Rgb::ZERO, start: 0, len: 0, scale: 0.0 };
+                    if let Some(hit) = objects.intersect(&ray, t) {
+                        let surface = objects.surface(&ray, hit);
                         texel.hit = Some(surface);
                         texel.t = hit.t;
                         texel.albedo = scene.material_at(&surface).albedo(surface.p, surface.n) * FRAC_1_PI;
                         if let Some(solution) = solution {
                             let n = if surface.n.dot(ray.dir) <= 0.0 { surface.n } else { -surface.n };
                             texel.start = weights.len() as u32;
-                            if let Some(scale) = solution.lookup().weights(solution.patches(), surface.p, n, &mut weights) {
+                            let lookup = solution.lookup();
+                            if let Some(scale) = lookup.weights(solution.patches(), surface.p, n, weights) {
                                 texel.len = weights.len() as u32 - texel.start;
                                 texel.scale = scale;
                             }
                         }
                     }
-                    texels.push(texel);
                 }
-                (texels, weights)
-            })
-            .collect();
-        self.texels.clear();
-        self.weights.clear();
-        for (texels, weights) in rows {
-            let base = self.weights.len() as u32;
-            self.texels.extend(texels.into_iter().map(|t| Texel { start: t.start + base, ..t }));
-            self.weights.extend(weights);
-        }
+            },
+        );
         self.key = Some(key(scene));
     }
 
@@ -139,6 +135,7 @@ impl FirstSample {
         solution: Option<&Radiosity>,
         preview: &Preview,
         lights: &Geometry,
+        row: usize,
         index: usize,
     ) -> Rgb {
         let texel = &self.texels[index];
@@ -157,7 +154,7 @@ impl FirstSample {
                     if let Some(solution) = solution {
                         let e = if texel.len > 0 {
                             let e = solution.indirect_irradiance();
-                            let ws = &self.weights[texel.start as usize..(texel.start + texel.len) as usize];
+                            let ws = &self.weights[row][texel.start as usize..(texel.start + texel.len) as usize];
                             Some(ws.iter().fold(Rgb::ZERO, |sum, &(i, w)| sum + e[i as usize] * w) * texel.scale)
                         } else {
                             None

@@ -14,7 +14,7 @@
 //! The patches are binned in a hash grid of cells of size R.
 
 use super::patches::Patch;
-use glam::{IVec3, Vec3};
+use glam::{I64Vec3, IVec3, Vec3};
 use rayon::slice::ParallelSliceMut;
 use std::collections::HashMap;
 use std::hash::{BuildHasherDefault, Hasher};
@@ -34,70 +34,105 @@ pub struct Lookup {
 /// Lookups of more patches than this probe the grid's cells instead of
 /// making candidate lists (about 400 bytes a patch: 50 MB here).
 pub const MAX_NEAR_PATCHES: usize = 1 << 17;
+/// Nor are lists made when their grid, dense over the patches' bounding
+/// box, would have more cells than this (4 bytes each: 32 MB): an infinite
+/// plane's outer rings reach far.
+pub const MAX_NEAR_CELLS: usize = 1 << 23;
 
 /// Per cell of a finer grid (side R/2), the patches whose centres lie
 /// within R of the cell: every patch the kernel could take at a point in
 /// it, listed in the order the probing of the coarse cells takes them. A
-/// query is then one hash probe and one short list (a dozen patches on a
-/// flat wall) instead of up to 27 probes; the sum, term by term in the same
-/// order, is the same to the bit.
+/// query is then one index into a dense grid and one short list (a dozen
+/// patches on a flat wall) instead of up to 27 hash probes; the sum, term
+/// by term in the same order, is the same to the bit.
 #[derive(Clone, Debug, Default)]
 struct Near {
     cell: f32,
-    cells: HashMap<IVec3, (u32, u32), BuildHasherDefault<CellHasher>>,
+    /// The grid's first cell and its size in cells.
+    lo: IVec3,
+    size: IVec3,
+    /// Cell k's list is `ids[starts[k]..starts[k + 1]]`, cells in x-major order.
+    starts: Vec<u32>,
     ids: Vec<u32>,
     /// Centre and normal of every patch, packed for the lists' gathers.
     points: Vec<(Vec3, Vec3)>,
 }
 
 impl Near {
-    /// The lists for `ids`, the patches in the probing order.
-    fn build(patches: &[Patch], ids: &[u32], radius: f32) -> Near {
+    /// The lists for `ids`, the patches in the probing order; None when
+    /// the grid would be too large.
+    fn build(patches: &[Patch], ids: &[u32], radius: f32) -> Option<Near> {
+        if patches.is_empty() || patches.len() > MAX_NEAR_PATCHES {
+            return None;
+        }
         let cell = 0.5 * radius;
         // Generous against rounding: a longer list costs little, a patch
         // left out would change the answer.
         let reach = radius * (1.0 + 1e-3);
-        let mut keyed: Vec<(IVec3, u32)> = Vec::new();
+        let span = |c: Vec3| (((c - reach) / cell).floor().as_ivec3(), ((c + reach) / cell).floor().as_ivec3());
+        let (mut lo, mut hi) = (IVec3::MAX, IVec3::MIN);
+        for p in patches {
+            let (a, b) = span(p.center);
+            (lo, hi) = (lo.min(a), hi.max(b));
+        }
+        let size = hi.as_dvec3() - lo.as_dvec3() + 1.0;
+        let cells = size.element_product();
+        if !(cells <= MAX_NEAR_CELLS as f64) {
+            return None;
+        }
+        let size = size.as_ivec3();
+        let index = |k: IVec3| {
+            let k = k - lo;
+            ((k.x * size.y + k.y) * size.z + k.z) as u32
+        };
+        let mut keyed: Vec<(u32, u32)> = Vec::new();
         for (rank, &i) in ids.iter().enumerate() {
             let c = patches[i as usize].center;
-            let lo = ((c - reach) / cell).floor().as_ivec3();
-            let hi = ((c + reach) / cell).floor().as_ivec3();
-            for x in lo.x..=hi.x {
-                for y in lo.y..=hi.y {
-                    for z in lo.z..=hi.z {
+            let (a, b) = span(c);
+            for x in a.x..=b.x {
+                for y in a.y..=b.y {
+                    for z in a.z..=b.z {
                         let key = IVec3::new(x, y, z);
                         let box_lo = key.as_vec3() * cell;
                         if c.clamp(box_lo, box_lo + cell).distance(c) < reach {
-                            keyed.push((key, rank as u32));
+                            keyed.push((index(key), rank as u32));
                         }
                     }
                 }
             }
         }
-        keyed.par_sort_unstable_by_key(|&(c, rank)| (c.x, c.y, c.z, rank));
-        let mut cells = HashMap::default();
-        let mut start = 0;
-        while start < keyed.len() {
-            let c = keyed[start].0;
-            let mut end = start;
-            while end < keyed.len() && keyed[end].0 == c {
-                end += 1;
-            }
-            cells.insert(c, (start as u32, end as u32));
-            start = end;
+        keyed.par_sort_unstable();
+        let mut starts = vec![0u32; size.element_product() as usize + 1];
+        for &(k, _) in &keyed {
+            starts[k as usize + 1] += 1;
         }
-        Near {
+        for k in 1..starts.len() {
+            starts[k] += starts[k - 1];
+        }
+        Some(Near {
             cell,
-            cells,
+            lo,
+            size,
+            starts,
             ids: keyed.into_iter().map(|(_, rank)| ids[rank as usize]).collect(),
             points: patches.iter().map(|p| (p.center, p.normal)).collect(),
+        })
+    }
+
+    /// The list of the cell that holds `p` (empty outside the grid).
+    #[inline]
+    fn list(&self, p: Vec3) -> &[u32] {
+        // In i64: a far point's cell saturates i32.
+        let (k, size) = ((p / self.cell).floor().as_i64vec3() - self.lo.as_i64vec3(), self.size.as_i64vec3());
+        if k.cmplt(I64Vec3::ZERO).any() || k.cmpge(size).any() {
+            return &[];
         }
+        let k = ((k.x * size.y + k.y) * size.z + k.z) as usize;
+        &self.ids[self.starts[k] as usize..self.starts[k + 1] as usize]
     }
 
     fn bytes(&self) -> usize {
-        self.ids.capacity() * 4
-            + self.points.capacity() * size_of::<(Vec3, Vec3)>()
-            + self.cells.capacity() * (size_of::<IVec3>() + 8 + 8)
+        (self.ids.capacity() + self.starts.capacity()) * 4 + self.points.capacity() * size_of::<(Vec3, Vec3)>()
     }
 }
 
@@ -186,13 +221,41 @@ impl Lookup {
         keep: impl Fn(usize) -> bool,
         mut term: impl FnMut(usize, f32),
     ) -> f32 {
-        let near = self.near.get_or_init(|| {
-            (patches.len() <= MAX_NEAR_PATCHES).then(|| Near::build(patches, &self.ids, self.radius))
-        });
+        let near = self.near.get_or_init(|| Near::build(patches, &self.ids, self.radius));
         let r = self.radius;
         let mut weight = 0.0;
+        if let Some(near) = near {
+            // Eight candidates at a time, their tests and weights computed
+            // without branches (so the compiler can use vector lanes), then
+            // their terms taken in order: the arithmetic of `take` below,
+            // operation for operation, so the same bits.
+            const LANES: usize = 8;
+            for chunk in near.list(p).chunks(LANES) {
+                let (mut c, mut m) = ([[0.0f32; LANES]; 3], [[0.0f32; LANES]; 3]);
+                for (k, &i) in chunk.iter().enumerate() {
+                    let (center, normal) = near.points[i as usize];
+                    (c[0][k], c[1][k], c[2][k]) = (center.x, center.y, center.z);
+                    (m[0][k], m[1][k], m[2][k]) = (normal.x, normal.y, normal.z);
+                }
+                let (mut w, mut ok) = ([0.0f32; LANES], [false; LANES]);
+                for k in 0..LANES {
+                    let d = Vec3::new(c[0][k], c[1][k], c[2][k]) - p;
+                    let facing = 2.0 * n.dot(Vec3::new(m[0][k], m[1][k], m[2][k])) - 1.0;
+                    let dist = d.length();
+                    ok[k] = !(facing <= 0.0) & !(n.dot(d).abs() > 0.5 * r) & !(dist >= r);
+                    w[k] = (1.0 - dist / r) * facing;
+                }
+                for (k, &i) in chunk.iter().enumerate() {
+                    if ok[k] && keep(i as usize) {
+                        term(i as usize, w[k]);
+                        weight += w[k];
+                    }
+                }
+            }
+            return weight;
+        }
         // One patch's term: the tests and the arithmetic of the module
-        // documentation, the same in both paths below.
+        // documentation, as the lists' lanes do it.
         let mut take = |i: u32, center: Vec3, normal: Vec3| {
             let d = center - p;
             let facing = 2.0 * n.dot(normal) - 1.0;
@@ -207,16 +270,6 @@ impl Lookup {
             term(i as usize, w);
             weight += w;
         };
-        if let Some(near) = near {
-            let key = (p / near.cell).floor().as_ivec3();
-            if let Some(&(a, b)) = near.cells.get(&key) {
-                for &i in &near.ids[a as usize..b as usize] {
-                    let (center, normal) = near.points[i as usize];
-                    take(i, center, normal);
-                }
-            }
-            return weight;
-        }
         let lo = ((p - r) / r).floor().as_ivec3();
         let hi = ((p + r) / r).floor().as_ivec3();
         // Cells that hold no centre the loop below could take are passed
