@@ -331,6 +331,21 @@ mod tests {
     }
 
     #[test]
+    fn a_first_frame_kept_as_an_image_is_the_one_sample_render_and_refines_the_same() {
+        let mut scene = SceneFile::from_toml_str(super::super::DEFAULT_SCENE, None).unwrap().scene;
+        let s = scene.settings_mut();
+        (s.width, s.height, s.spp) = (32, 18, 1);
+        let mut e = engine();
+        e.frame();
+        assert!(matches!(e.accumulator, Samples::First(_)));
+        let once = airlight::render(&scene, &e.preview(), &RenderObserver::none());
+        assert_eq!(e.image(), once);
+        e.frame();
+        scene.settings_mut().spp = 2;
+        assert_eq!(e.image(), airlight::render(&scene, &e.preview(), &RenderObserver::none()));
+    }
+
+    #[test]
     fn moving_a_light_relights_and_starts_over_while_a_still_one_does_not() {
         let mut e = engine();
         e.frame();

@@ -11,7 +11,14 @@
 //! behind). R = 1.5 × patch size, so a point always has its own patch's
 //! centre inside the kernel (a patch's centre is at most √½ × patch size
 //! from its points), and the weights, hence the shading, vary continuously.
-//! The patches are binned in a hash grid of cells of size R.
+//! The patches are binned in a hash grid of cells of size R. On the first
+//! query, a finer dense grid (cells of R/2) gets per cell the list of
+//! patches within R of it, in the order the hash grid's cells give them:
+//! a query then reads one list (a dozen patches on a wall) instead of
+//! probing up to 27 cells, and sums the same terms in the same order, so
+//! the answer is the same to the bit. Scenes with more than
+//! [`MAX_NEAR_PATCHES`] patches, or whose grid would be too large, keep
+//! probing.
 
 use super::patches::Patch;
 use glam::{I64Vec3, IVec3, Vec3};
