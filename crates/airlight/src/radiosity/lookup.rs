@@ -84,7 +84,7 @@ impl Near {
         }
         let size = hi.as_dvec3() - lo.as_dvec3() + 1.0;
         let cells = size.element_product();
-        if !(cells <= MAX_NEAR_CELLS as f64) {
+        if cells.is_nan() || cells > MAX_NEAR_CELLS as f64 {
             return None;
         }
         let size = size.as_ivec3();
@@ -249,7 +249,9 @@ impl Lookup {
                     let d = Vec3::new(c[0][k], c[1][k], c[2][k]) - p;
                     let facing = 2.0 * n.dot(Vec3::new(m[0][k], m[1][k], m[2][k])) - 1.0;
                     let dist = d.length();
-                    ok[k] = !(facing <= 0.0) & !(n.dot(d).abs() > 0.5 * r) & !(dist >= r);
+                    // `take`'s rejections, NaNs included.
+                    let reject = (facing <= 0.0) | (n.dot(d).abs() > 0.5 * r) | (dist >= r);
+                    ok[k] = !reject;
                     w[k] = (1.0 - dist / r) * facing;
                 }
                 for (k, &i) in chunk.iter().enumerate() {
