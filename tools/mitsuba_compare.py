@@ -91,7 +91,7 @@ def rectangle(corner, eu, ev):
     return mi.ScalarTransform4f(m)
 
 
-def translate(path, spp):
+def translate(path, spp, sampler="independent"):
     import mitsuba as mi
     with open(path, "rb") as f:
         s = tomllib.load(f)
@@ -138,7 +138,7 @@ def translate(path, spp):
             origin=cam.get("position", [0, 2, -6]), target=cam.get("look_at", [0, 1, 0]), up=cam.get("up", [0, 1, 0])
         ),
         "film": {"type": "hdrfilm", "width": width, "height": height, "rfilter": {"type": "box"}, "pixel_format": "rgb"},
-        "sampler": {"type": "independent", "sample_count": spp},
+        "sampler": {"type": sampler, "sample_count": spp},
     }
     if medium:
         sensor["medium"] = {"type": "ref", "id": "fog"}
@@ -257,6 +257,12 @@ def main():
     p.add_argument("scenes", nargs="+")
     p.add_argument("--spp", type=int, default=256)
     p.add_argument("--variant", action="append", help="Mitsuba variant, may repeat (default: llvm_ad_rgb and scalar_rgb)")
+    p.add_argument(
+        "--mitsuba-sampler",
+        default="independent",
+        help="Mitsuba's sampler: independent (default), stratified, multijitter, orthogonal or ldsampler; "
+        "Airlight's path tracer stratifies its samples (Owen-scrambled Sobol') unless the scene says stratify = false",
+    )
     p.add_argument("--out", default=os.path.join(tempfile.gettempdir(), "airlight-mitsuba"))
     args = p.parse_args()
     import drjit as dr
@@ -280,7 +286,7 @@ def main():
         print(f"{name}: {args.spp} spp, {integrator}; Airlight {airlight_seconds:.3f} s, own error {e_a:.4f}")
         for variant in variants:
             mi.set_variant(variant)
-            scene_dict, _, _ = translate(path, args.spp)
+            scene_dict, _, _ = translate(path, args.spp, args.mitsuba_sampler)
             scene = mi.load_dict(scene_dict)
             time_mitsuba(mi, dr, scene, args.spp, 7)  # compiles the llvm kernels
             mitsuba_seconds, image = time_mitsuba(mi, dr, scene, args.spp, 0)
@@ -294,7 +300,7 @@ def main():
             # Each image's own error is the seed-to-seed difference over √2;
             # error falls as 1/√time, so equal error costs time · error².
             e_m = field(mitsuba_noise, "rel_rmse") / math.sqrt(2)
-            print(f"  Mitsuba {variant}: {mitsuba_seconds:.3f} s, own error {e_m:.4f}; per sample Airlight is {mitsuba_seconds / airlight_seconds:.2f}x as fast", end="")
+            print(f"  Mitsuba {variant} ({args.mitsuba_sampler} sampler): {mitsuba_seconds:.3f} s, own error {e_m:.4f}; per sample Airlight is {mitsuba_seconds / airlight_seconds:.2f}x as fast", end="")
             if e_a > 0:
                 speedup = (mitsuba_seconds * e_m**2) / (airlight_seconds * e_a**2)
                 print(f", at equal error {speedup:.2f}x", end="")

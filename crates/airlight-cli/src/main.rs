@@ -204,10 +204,11 @@ fn gi(args: GiArgs) -> Result<(), String> {
         let ms = |d: std::time::Duration| d.as_secs_f64() * 1e3;
         println!("scene: {}", args.scene.display());
         println!(
-            "threads: {}, patch_size: {}, link_threshold: {}, bounces: {}",
+            "threads: {}, patch_size: {}, link_threshold: {}, receiver_share: {}, bounces: {}",
             rayon::current_num_threads(),
             params.patch_size,
             params.link_threshold,
+            params.receiver_share,
             desc.radiosity.bounces
         );
         println!("patches: {} ({} sides that see nothing dropped), clusters: {}", st.patches, st.dropped, st.clusters);

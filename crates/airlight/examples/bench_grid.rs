@@ -55,7 +55,7 @@ fn main() {
         return load(std::path::Path::new(&dir));
     }
     let n: usize = std::env::args().nth(1).and_then(|a| a.parse().ok()).unwrap_or(512);
-    let tracer = PathTracer::new(PathOptions { max_depth: 1 });
+    let tracer = PathTracer::new(PathOptions { max_depth: 1, ..PathOptions::default() });
     let reference = render(&cloud_scene(16, 1024), &tracer, &RenderObserver::none());
     println!("path tracer, cloud_sun's grid (72×20×96), 160×90, single scattering, 64 spp:");
     for (cells, name) in [(16, "majorant grid 16³"), (1, "one global majorant")] {

@@ -62,7 +62,7 @@ fn main() {
     );
 
     scene.settings_mut().spp = path_spp;
-    let tracer = PathTracer::new(PathOptions { max_depth: 1 });
+    let tracer = PathTracer::new(PathOptions { max_depth: 1, ..PathOptions::default() });
     let t = Instant::now();
     let state = one.install(|| progressive(&scene, &tracer, |_, _| {}));
     let path_secs = t.elapsed().as_secs_f64();
@@ -83,7 +83,11 @@ fn main() {
         let (spp, seed) = (scene.settings().spp, scene.settings().seed);
         let s = scene.settings_mut();
         (s.spp, s.seed) = (ref_spp, seed.wrapping_add(1));
-        let image = render_with(&scene, &PathTracer::new(PathOptions { max_depth: 8 }), &RenderObserver::none());
+        let image = render_with(
+            &scene,
+            &PathTracer::new(PathOptions { max_depth: 8, ..PathOptions::default() }),
+            &RenderObserver::none(),
+        );
         let s = scene.settings_mut();
         (s.spp, s.seed) = (spp, seed);
         image.save(file).expect("cannot write the reference");
@@ -94,7 +98,7 @@ fn main() {
     let mut last = (0.0, f64::INFINITY);
     let mut reached = None;
     one.install(|| {
-        progressive(&scene, &PathTracer::new(PathOptions { max_depth: 8 }), |state, secs| {
+        progressive(&scene, &PathTracer::new(PathOptions { max_depth: 8, ..PathOptions::default() }), |state, secs| {
             let e = state.estimated_relative_error();
             let measured = reference.as_ref().map(|r| format!(" {:.4}", compare(&state.image(), r).unwrap().rel_rmse));
             println!("  {} {secs:.2} {e:.4}{}", state.samples(), measured.unwrap_or_default());

@@ -118,6 +118,19 @@ impl Material {
         }
     }
 
+    /// The BRDF and [`Material::pdf`] together, for light samples, which
+    /// need both.
+    pub fn eval(&self, p: Vec3, n: Vec3, wo: Vec3, wi: Vec3) -> (Rgb, f32) {
+        if let Material::Diffuse { albedo } = *self {
+            let (cos_o, cos_i) = (n.dot(wo), n.dot(wi));
+            let f = if cos_o * cos_i > 0.0 { albedo / PI } else { Rgb::ZERO };
+            // As `pdf`: cosine about the normal turned toward wo.
+            let cos = if cos_o < 0.0 { -cos_i } else { cos_i };
+            return (f, if cos > 0.0 { cos / PI } else { 0.0 });
+        }
+        (self.brdf(p, n, wo, wi), self.pdf(p, n, wo, wi))
+    }
+
     /// Solid-angle pdf with which [`Material::sample`] draws `wi`.
     pub fn pdf(&self, p: Vec3, n: Vec3, wo: Vec3, wi: Vec3) -> f32 {
         // Directions are drawn on wo's side; `n` itself still picks the
@@ -145,6 +158,17 @@ impl Material {
     /// draw falls below the surface.
     pub fn sample(&self, p: Vec3, n: Vec3, wo: Vec3, u: glam::Vec2, u_lobe: f32) -> Option<BsdfSample> {
         let facing = if n.dot(wo) < 0.0 { -n } else { n };
+        if let Material::Diffuse { albedo } = *self {
+            // The common case in one step: the general path below computes
+            // the same pdf and BRDF through `pdf` and `brdf`.
+            let wi = crate::sampling::to_world(crate::sampling::cosine_hemisphere(u), facing);
+            let cos = facing.dot(wi);
+            if cos <= 0.0 {
+                return None;
+            }
+            let f = if n.dot(wo) * n.dot(wi) > 0.0 { albedo / PI } else { Rgb::ZERO };
+            return Some(BsdfSample { wi, f, pdf: cos / PI });
+        }
         let wi = if u_lobe < self.lobe_probability(p, n) {
             let Material::Phong { exponent, .. } = *self else { unreachable!() };
             let mirror = 2.0 * facing.dot(wo) * facing - wo;
@@ -216,6 +240,27 @@ mod tests {
             }
             let est = sum / n as f32;
             assert!((est.x - reference.x).abs() < 0.01, "{m:?}: {est} vs {reference}");
+        }
+    }
+
+    #[test]
+    fn eval_is_brdf_and_pdf_and_diffuse_samples_match_them() {
+        let mut s = Sampler::for_pixel(4, 4, 4);
+        let materials = [
+            Material::diffuse(Rgb::new(0.7, 0.5, 0.2)),
+            Material::phong(Rgb::splat(0.3), Rgb::splat(0.5), 15.0),
+            Material::checker(Rgb::ONE, Rgb::splat(0.2), 0.5),
+        ];
+        for m in &materials {
+            for _ in 0..2000 {
+                let (p, n) = (uniform_sphere(s.next2()) * 3.0, uniform_sphere(s.next2()));
+                let (wo, wi) = (uniform_sphere(s.next2()), uniform_sphere(s.next2()));
+                assert_eq!(m.eval(p, n, wo, wi), (m.brdf(p, n, wo, wi), m.pdf(p, n, wo, wi)), "{m:?}");
+                if let Some(b) = m.sample(p, n, wo, s.next2(), s.next()) {
+                    let (f, pdf) = (m.brdf(p, n, wo, b.wi), m.pdf(p, n, wo, b.wi));
+                    assert!((b.f - f).abs().max_element() < 1e-6 && (b.pdf - pdf).abs() < 1e-5 * pdf.max(1.0), "{m:?}");
+                }
+            }
         }
     }
 

@@ -134,7 +134,7 @@ fn quad_light_on_a_floor_through_the_integrators_matches_lambert() {
     let expected = lambert_irradiance(corner, u, v, 1.0) / std::f64::consts::PI;
     for (name, integrator) in [
         ("direct", &Direct as &dyn Integrator),
-        ("path", &airlight::integrator::PathTracer::new(PathOptions { max_depth: 1 })),
+        ("path", &airlight::integrator::PathTracer::new(PathOptions { max_depth: 1, ..PathOptions::default() })),
         ("raymarch", &airlight::integrator::Raymarch::new(RaymarchOptions { steps: 4, jitter: true })),
     ] {
         let got = render(&scene, integrator, &RenderObserver::none()).mean().x as f64;

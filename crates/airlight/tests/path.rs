@@ -39,7 +39,7 @@ fn white_furnace_gives_the_wall_radiance_everywhere() {
     ] {
         let image = render(
             &furnace(medium.clone()),
-            &PathTracer::new(PathOptions { max_depth: 10_000 }),
+            &PathTracer::new(PathOptions { max_depth: 10_000, ..PathOptions::default() }),
             &RenderObserver::none(),
         );
         // The image mean against 1, within four standard errors (measured
@@ -144,13 +144,14 @@ fn single_scattering_path_tracing_agrees_with_marching() {
     // optical depth, and by delta and ratio tracking (the path for media
     // without a closed form).
     let height = Medium::height(Rgb::splat(0.02), Rgb::splat(0.15), 0.0, 0.0, 0.4);
-    let tracking = PathTracer { closed_form: false, ..PathTracer::new(PathOptions { max_depth: 1 }) };
+    let tracking =
+        PathTracer { closed_form: false, ..PathTracer::new(PathOptions { max_depth: 1, ..PathOptions::default() }) };
     for (medium, tracer) in [
         (
             Medium::homogeneous(Rgb::new(0.02, 0.03, 0.04), Rgb::new(0.10, 0.07, 0.05), 0.3),
-            PathTracer::new(PathOptions { max_depth: 1 }),
+            PathTracer::new(PathOptions { max_depth: 1, ..PathOptions::default() }),
         ),
-        (height.clone(), PathTracer::new(PathOptions { max_depth: 1 })),
+        (height.clone(), PathTracer::new(PathOptions { max_depth: 1, ..PathOptions::default() })),
         (height, tracking),
     ] {
         let path = render(&fog_scene(medium.clone(), 32_768, 0), &tracer, &RenderObserver::none());
@@ -187,7 +188,7 @@ fn equiangular_light_sampling_lowers_the_error_near_lights() {
     let marched =
         render(&in_view(16), &Raymarch::new(RaymarchOptions { steps: 4096, jitter: true }), &RenderObserver::none());
     let error = |equiangular| {
-        let tracer = PathTracer { max_depth: 1, equiangular, closed_form: true };
+        let tracer = PathTracer { max_depth: 1, equiangular, closed_form: true, stratify: true };
         compare(&render(&in_view(64), &tracer, &RenderObserver::none()), &marched).unwrap().rel_rmse
     };
     let (free_flight, with_equiangular) = (error(false), error(true));

@@ -159,7 +159,7 @@ fn a_constant_grid_renders_like_the_homogeneous_medium_of_its_density() {
     // free-flight estimator infinite variance.
     let lamp = Light::sphere(vec3(0.3, 0.4, 0.2), 0.4, Rgb::splat(4.0));
     for depth in [1, 6] {
-        let tracer = PathTracer::new(PathOptions { max_depth: depth });
+        let tracer = PathTracer::new(PathOptions { max_depth: depth, ..PathOptions::default() });
         let gridded = fog_scene(Medium::grid(sigma_a, sigma_s, 0.3, grid.clone()), lamp, camera, 1024);
         let homogeneous = fog_scene(Medium::homogeneous(sigma_a * 0.5, sigma_s * 0.5, 0.3), lamp, camera, 1024);
         let (ratio, rel) = error_over_noise(&gridded, &tracer, &homogeneous, &tracer);
@@ -200,7 +200,7 @@ fn single_scattering_in_a_random_grid_agrees_between_path_raymarch_and_stochasti
     let path_scene = fog_scene(m.clone(), lamp, camera, 2048);
     let sums = accumulate(
         &path_scene,
-        &PathTracer::new(PathOptions { max_depth: 1 }),
+        &PathTracer::new(PathOptions { max_depth: 1, ..PathOptions::default() }),
         0..2048,
         0..16,
         &RenderObserver::none(),
@@ -263,7 +263,7 @@ fn noise_fog_tracks_to_its_quadrature_and_renders_alike_by_path_and_raymarch() {
     );
     let sums = accumulate(
         &fog_scene(m, lamp, camera, 2048),
-        &PathTracer::new(PathOptions { max_depth: 1 }),
+        &PathTracer::new(PathOptions { max_depth: 1, ..PathOptions::default() }),
         0..2048,
         0..16,
         &RenderObserver::none(),

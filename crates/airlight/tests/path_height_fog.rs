@@ -124,8 +124,10 @@ fn single_scattering_in_height_fog_agrees_with_marching_within_noise() {
             &Raymarch::new(RaymarchOptions { steps: 2048, jitter: false }),
             &RenderObserver::none(),
         );
-        let (path, variance) =
-            path_with_variance(&open_fog(medium, light, camera, spp), &PathTracer::new(PathOptions { max_depth: 1 }));
+        let (path, variance) = path_with_variance(
+            &open_fog(medium, light, camera, spp),
+            &PathTracer::new(PathOptions { max_depth: 1, ..PathOptions::default() }),
+        );
         let e = compare(&path, &marched).unwrap();
         // The squared differences against the path tracer's own variance of
         // each pixel mean: near 1 when they differ by noise alone (0.8–1.6
@@ -165,7 +167,11 @@ fn extreme_height_fog_gives_finite_images() {
     for (medium, camera) in cases {
         let mut scene = open_fog(medium.clone(), Light::point(vec3(0.0, 0.5, 0.0), Rgb::splat(10.0)), camera, 16);
         (scene.settings_mut().width, scene.settings_mut().height) = (8, 8);
-        let image = render_with(&scene, &PathTracer::new(PathOptions { max_depth: 8 }), &RenderObserver::none());
+        let image = render_with(
+            &scene,
+            &PathTracer::new(PathOptions { max_depth: 8, ..PathOptions::default() }),
+            &RenderObserver::none(),
+        );
         for p in &image.pixels {
             assert!(p.is_finite() && p.min_element() >= 0.0, "{medium:?}: pixel {p}");
         }

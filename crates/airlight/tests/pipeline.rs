@@ -43,6 +43,7 @@ fn every_integrator_sees_a_vacuum_and_surfaces_beyond_max_distance_as_direct_doe
             desc.path.max_depth = 1;
             // Stratified camera samples would place the rays elsewhere.
             desc.stochastic.stratify = false;
+            desc.path.stratify = false;
             let integrator = desc.build(&scene).unwrap();
             let image = render(&scene, integrator.as_ref(), &Default::default());
             let e = compare(&image, &direct).unwrap();

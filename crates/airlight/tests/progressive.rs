@@ -26,10 +26,12 @@ fn scene(spp: u32, seed: u64) -> Scene {
         .unwrap()
 }
 
-/// The integrator `kind`; the path tracer at two scattering events.
+/// The integrator `kind`; the path tracer at two scattering events, with
+/// independent samples (the error estimate's assumption).
 fn integrator(kind: IntegratorKind, scene: &Scene) -> Box<dyn airlight::integrator::Integrator> {
     let mut desc = IntegratorDesc::new(kind);
     desc.path.max_depth = 2;
+    desc.path.stratify = false;
     desc.build(scene).unwrap()
 }
 

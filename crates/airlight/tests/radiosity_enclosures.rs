@@ -197,7 +197,11 @@ fn room_against_path(name: &str, kind: Room, bounces: u32, spp: u32) -> (f64, f6
     let rad = render(&scene, &radiosity, &RenderObserver::none());
     let path = |seed: u64| {
         let scene = box_room(kind, spp, seed);
-        render(&scene, &PathTracer::new(PathOptions { max_depth: bounces + 1 }), &RenderObserver::none())
+        render(
+            &scene,
+            &PathTracer::new(PathOptions { max_depth: bounces + 1, ..PathOptions::default() }),
+            &RenderObserver::none(),
+        )
     };
     let (p1, p2) = (path(1), path(2));
     let mut reference = p1.clone();

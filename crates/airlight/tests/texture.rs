@@ -67,8 +67,14 @@ irradiance = 3.14159265
 "#;
 
 fn render(text: &str, dir: &Path) -> Vec<Vec<Vec3>> {
+    render_with(IntegratorKind::Direct, text, dir)
+}
+
+fn render_with(kind: IntegratorKind, text: &str, dir: &Path) -> Vec<Vec<Vec3>> {
     let file = SceneFile::from_toml_str(text, Some(dir)).unwrap_or_else(|e| panic!("{e}"));
-    let integrator = IntegratorDesc::new(IntegratorKind::Direct).build(&file.scene).unwrap();
+    let mut desc = IntegratorDesc::new(kind);
+    desc.path.max_depth = 1;
+    let integrator = desc.build(&file.scene).unwrap();
     let acc = accumulate(&file.scene, integrator.as_ref(), 0..1, 0..4, &Default::default());
     (0..4).map(|j| (0..4).map(|i| acc.pixel(i, j).unwrap().mean()).collect()).collect()
 }
@@ -97,6 +103,10 @@ fn a_texture_material_on_a_quad_is_filtered_bilinearly_in_linear_light() {
              [[objects]]\ntype = \"quad\"\ncorner = [0, 0, 0]\nedge_u = [2, 0, 0]\nedge_v = [0, 2, 0]\nmaterial = \"t\"\n"
         );
         check(&format!("toml {wrap}"), &render(&text, dir.path()), clamp, Vec3::new(1.0, 0.5, 0.25));
+        // The path tracer's light sample (the sun is found only by it)
+        // sees the texel's colour too, not the texture's mean.
+        let image = render_with(IntegratorKind::Path, &text, dir.path());
+        check(&format!("path, toml {wrap}"), &image, clamp, Vec3::new(1.0, 0.5, 0.25));
     }
 }
 

@@ -28,8 +28,10 @@ pub struct Equiangular {
     /// Distance of the point from the line (kept above a floor so the pdf
     /// stays finite when the point lies on the line).
     h: f64,
-    theta_a: f64,
-    theta_b: f64,
+    /// tan θa = (t0 − t_c)/h.
+    tan_a: f64,
+    /// θb − θa.
+    angle: f64,
 }
 
 impl Equiangular {
@@ -41,25 +43,32 @@ impl Equiangular {
         let (t0, t1) = (t0 as f64, t1 as f64);
         let floor = 1e-6 * (1.0 + (t1 - t0).abs() + tc.abs());
         let h = (o + d * tc - y).length().max(floor).max(spread as f64);
-        let theta_a = ((t0 - tc) / h).atan();
-        let theta_b = ((t1 - tc) / h).atan();
-        Equiangular { t0, t1, tc, h, theta_a, theta_b }
+        // θb − θa in one atan2, by tan(θb − θa) = (B − A)/(1 + A·B) with
+        // A, B = tan θa, b; B ≥ A puts it in [0, π) whatever the sign of
+        // 1 + A·B. One transcendental call fewer than two atans, and no
+        // cancellation when both angles are near ±π/2.
+        let (tan_a, tan_b) = ((t0 - tc) / h, (t1 - tc) / h);
+        let angle = (tan_b - tan_a).atan2(1.0 + tan_a * tan_b);
+        Equiangular { t0, t1, tc, h, tan_a, angle }
     }
 
-    /// The t drawn by u uniform in [0, 1).
+    /// The t drawn by u uniform in [0, 1): t = t_c + h·tan(θa + u·Δθ),
+    /// expanded by the tangent's addition rule, so that θa itself is not
+    /// needed.
     pub fn sample(&self, u: f32) -> f32 {
-        let theta = self.theta_a + u as f64 * (self.theta_b - self.theta_a);
-        (self.tc + self.h * theta.tan()).clamp(self.t0, self.t1) as f32
+        let (sin, cos) = (u as f64 * self.angle).sin_cos();
+        let tan_theta = (self.tan_a * cos + sin) / (cos - self.tan_a * sin);
+        (self.tc + self.h * tan_theta).clamp(self.t0, self.t1) as f32
     }
 
     /// The density of t (0 outside [t0, t1]).
     pub fn pdf(&self, t: f32) -> f32 {
         let t = t as f64;
-        if !(t >= self.t0 && t <= self.t1) || self.theta_b <= self.theta_a {
+        if !(t >= self.t0 && t <= self.t1) || self.angle <= 0.0 {
             return 0.0;
         }
         let x = t - self.tc;
-        (self.h / ((self.theta_b - self.theta_a) * (self.h * self.h + x * x))) as f32
+        (self.h / (self.angle * (self.h * self.h + x * x))) as f32
     }
 }
 

@@ -108,11 +108,14 @@ pub struct PathOptions {
     /// Most scattering events; 1 is direct light on surfaces plus single
     /// scattering in the medium.
     pub max_depth: u32,
+    /// Draw each bounce's light sample and scattering direction from the
+    /// pixel's Owen-scrambled Sobol' points rather than independently.
+    pub stratify: bool,
 }
 
 impl Default for PathOptions {
     fn default() -> Self {
-        PathOptions { max_depth: 8 }
+        PathOptions { max_depth: 8, stratify: true }
     }
 }
 
@@ -256,6 +259,7 @@ impl IntegratorDesc {
         }
         if let Some(v) = r.stratify {
             d.stochastic.stratify = v;
+            d.path.stratify = v;
         }
         if let Some(v) = &r.max_depth {
             d.path.max_depth = render_count(v, "max_depth", 1, MAX_DEPTH)?;
@@ -299,7 +303,7 @@ mod tests {
         let cases: [(IntegratorDesc, &str); 6] = [
             (IntegratorDesc { raymarch: RaymarchOptions { steps: 0, jitter: true }, ..ok }, "steps"),
             (IntegratorDesc { analytic: AnalyticOptions { light_steps: 4097, ..ok.analytic }, ..ok }, "light_steps"),
-            (IntegratorDesc { path: PathOptions { max_depth: 0 }, ..ok }, "max_depth"),
+            (IntegratorDesc { path: PathOptions { max_depth: 0, ..PathOptions::default() }, ..ok }, "max_depth"),
             (IntegratorDesc { radiosity: RadiosityOptions { bounces: 0, ..ok.radiosity }, ..ok }, "bounces"),
             (
                 IntegratorDesc { radiosity: RadiosityOptions { link_threshold: -1.0, ..ok.radiosity }, ..ok },

@@ -163,6 +163,16 @@ impl Medium {
     /// the product stays finite (capped at f32::MAX deep below a height fog's
     /// base, where ρ alone overflows f32). Zero where the medium has no closed form.
     pub fn free_flight_scattering(&self, o: Vec3, d: Vec3, t: f32) -> Rgb {
+        if let Density::Homogeneous = self.density {
+            // ρ = 1: nothing to overflow, so f32 suffices.
+            let sigma_t = self.sigma_t();
+            let channel = |sigma_s: f32, sigma_t: f32| sigma_s * (-sigma_t * t).exp();
+            return Rgb::new(
+                channel(self.sigma_s.x, sigma_t.x),
+                channel(self.sigma_s.y, sigma_t.y),
+                channel(self.sigma_s.z, sigma_t.z),
+            );
+        }
         let Some(profile) = self.profile(o, d) else { return Rgb::ZERO };
         let ln_rho = profile.ln_rho0 - profile.a * t as f64;
         let x = profile.integral(0.0, t as f64);

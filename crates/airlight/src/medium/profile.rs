@@ -36,7 +36,18 @@ impl DensityProfile {
     /// ρ(t).
     #[inline]
     pub fn density(&self, t: f64) -> f64 {
+        if self.is_unit() {
+            return 1.0;
+        }
         (self.ln_rho0 - self.a * t).exp()
+    }
+
+    /// Whether ρ = 1 all along (a homogeneous medium): the exp and ln
+    /// below are then skipped, as the free flights of the path tracer ask
+    /// for them at every collision.
+    #[inline]
+    fn is_unit(&self) -> bool {
+        self.a == 0.0 && self.ln_rho0 == 0.0
     }
 
     /// ∫_{t0}^{t1} ρ dt (0 for an empty or reversed interval; t1 may be
@@ -47,6 +58,9 @@ impl DensityProfile {
         let length = t1 - t0;
         if length.is_nan() || length <= 0.0 {
             return 0.0;
+        }
+        if self.is_unit() {
+            return length;
         }
         let x = self.a.abs() * length;
         if length.is_infinite() {
@@ -66,6 +80,9 @@ impl DensityProfile {
     pub fn distance_to(&self, x: f64) -> f64 {
         if x.is_nan() || x <= 0.0 {
             return 0.0;
+        }
+        if self.is_unit() {
+            return x;
         }
         // ln q, q = x/ρ0: the distance at the starting density.
         let ln_q = x.ln() - self.ln_rho0;

@@ -19,7 +19,6 @@ use crate::sampling::Sampler;
 use crate::scene::{PixelFilter, Scene};
 use glam::Vec2;
 use rayon::prelude::*;
-use std::cell::RefCell;
 use std::f32::consts::FRAC_1_PI;
 
 /// One pixel's camera ray and what it meets among the objects.
@@ -31,14 +30,11 @@ struct Texel {
     t: f32,
     /// The diffuse albedo at the hit, times 1/π.
     albedo: Rgb,
-    /// Lookup weights: `weights[start..start + len]`, times `scale`.
+    /// Lookup weights: `weights[row][start..start + len]`, times `scale`.
     start: u32,
     len: u32,
     scale: f32,
 }
-
-/// One image row's texels and the lookup weights they index.
-type Row = (Vec<Texel>, Vec<(u32, f32)>);
 
 /// What [`Camera`], size, seed and filter the cache was made for.
 type Key = (Camera, u32, u32, u64, PixelFilter);
@@ -50,7 +46,10 @@ pub struct FirstSample {
     /// The scene's objects without the lights' surfaces.
     objects: Geometry,
     texels: Vec<Texel>,
-    weights: Vec<(u32, f32)>,
+    /// Per image row, the lookup weights its texels index. Kept, with the
+    /// texels, from frame to frame: a moving camera refills them every
+    /// frame, into the memory the last frame used.
+    weights: Vec<Vec<(u32, f32)>>,
 }
 
 impl FirstSample {
@@ -76,10 +75,9 @@ impl FirstSample {
         let lights = light_surfaces(scene);
         let (w, h) = (scene.settings().width, scene.settings().height);
         let mut image = Image::new(w, h);
-        image.pixels.par_chunks_mut(w as usize).enumerate().for_each(|(y, row)| {
+        image.pixels.par_chunks_mut(w.max(1) as usize).enumerate().for_each(|(y, row)| {
             for (x, out) in row.iter_mut().enumerate() {
-                let index = y * w as usize + x;
-                *out = self.shade(scene, solution, preview, &lights, index);
+                *out = self.shade(scene, solution, preview, &lights, y, y * w as usize + x);
             }
         });
         image
@@ -88,12 +86,17 @@ impl FirstSample {
     fn fill(&mut self, scene: &Scene, solution: Option<&Radiosity>) {
         let s = scene.settings();
         let (w, h) = (s.width as usize, s.height as usize);
-        let rows: Vec<Row> = (0..h)
-            .into_par_iter()
-            .map(|y| {
-                let mut texels = Vec::with_capacity(w);
-                let mut weights = Vec::new();
-                for x in 0..w {
+        if self.texels.len() != w * h {
+            let ray = Ray::new(glam::Vec3::ZERO, glam::Vec3::Z);
+            let empty = Texel { ray, hit: None, t: 0.0, albedo: Rgb::ZERO, start: 0, len: 0, scale: 0.0 };
+            self.texels = vec![empty; w * h];
+        }
+        self.weights.resize_with(h, Vec::new);
+        let objects = &self.objects;
+        self.texels.par_chunks_mut(w.max(1)).zip(self.weights.par_iter_mut()).enumerate().for_each(
+            |(y, (texels, weights))| {
+                weights.clear();
+                for (x, texel) in texels.iter_mut().enumerate() {
                     let mut sampler = first_sampler(scene, (y * w + x) as u64);
                     let (jitter, lens) = (sampler.next2(), sampler.next2());
                     let film = Vec2::new(x as f32, y as f32)
@@ -103,33 +106,25 @@ impl FirstSample {
                         };
                     let ray = scene.camera().ray(film, s.width, s.height, lens);
                     let t = f32::INFINITY;
-                    let mut texel = Texel { ray, hit: None, t, albedo: Rgb::ZERO, start: 0, len: 0, scale: 0.0 };
-                    if let Some(hit) = self.objects.intersect(&ray, t) {
-                        let surface = self.objects.surface(&ray, hit);
+                    *texel = Texel { ray, hit: None, t, albedo: Rgb::ZERO, start: 0, len: 0, scale: 0.0 };
+                    if let Some(hit) = objects.intersect(&ray, t) {
+                        let surface = objects.surface(&ray, hit);
                         texel.hit = Some(surface);
                         texel.t = hit.t;
                         texel.albedo = scene.material_at(&surface).albedo(surface.p, surface.n) * FRAC_1_PI;
                         if let Some(solution) = solution {
                             let n = if surface.n.dot(ray.dir) <= 0.0 { surface.n } else { -surface.n };
                             texel.start = weights.len() as u32;
-                            if let Some(scale) = lookup_weights(solution, surface.p, n, &mut weights) {
+                            let lookup = solution.lookup();
+                            if let Some(scale) = lookup.weights(solution.patches(), surface.p, n, weights) {
                                 texel.len = weights.len() as u32 - texel.start;
                                 texel.scale = scale;
                             }
                         }
                     }
-                    texels.push(texel);
                 }
-                (texels, weights)
-            })
-            .collect();
-        self.texels.clear();
-        self.weights.clear();
-        for (texels, weights) in rows {
-            let base = self.weights.len() as u32;
-            self.texels.extend(texels.into_iter().map(|t| Texel { start: t.start + base, ..t }));
-            self.weights.extend(weights);
-        }
+            },
+        );
         self.key = Some(key(scene));
     }
 
@@ -140,6 +135,7 @@ impl FirstSample {
         solution: Option<&Radiosity>,
         preview: &Preview,
         lights: &Geometry,
+        row: usize,
         index: usize,
     ) -> Rgb {
         let texel = &self.texels[index];
@@ -158,7 +154,7 @@ impl FirstSample {
                     if let Some(solution) = solution {
                         let e = if texel.len > 0 {
                             let e = solution.indirect_irradiance();
-                            let ws = &self.weights[texel.start as usize..(texel.start + texel.len) as usize];
+                            let ws = &self.weights[row][texel.start as usize..(texel.start + texel.len) as usize];
                             Some(ws.iter().fold(Rgb::ZERO, |sum, &(i, w)| sum + e[i as usize] * w) * texel.scale)
                         } else {
                             None
@@ -196,70 +192,6 @@ fn light_surfaces(scene: &Scene) -> Geometry {
         g.add(&s.shape, s.material, s.emitter);
     }
     g.build()
-}
-
-/// One term, or the running sum, of the lookup's kernel average, run over
-/// this type instead of over colours to learn the lookup's patches and
-/// weights, whatever its kernel. The lookup computes
-/// (Σᵢ value(i)·wᵢ)·(1/Σ wᵢ): a single `value(i)` times a weight keeps the
-/// weight, adding it to the sum appends (patch, weight) to `sink`, and a
-/// factor on the sum is the final normalisation, kept in `scale`. Small and
-/// `Copy`, so the lookup's by-value arithmetic costs nothing.
-#[derive(Clone, Copy)]
-struct Term<'a> {
-    sink: Option<&'a RefCell<Vec<(u32, f32)>>>,
-    /// A single term's patch and weight (before it joins the sum).
-    single: Option<(u32, f32)>,
-    scale: f32,
-}
-
-impl Default for Term<'_> {
-    /// The empty sum.
-    fn default() -> Self {
-        Term { sink: None, single: None, scale: 1.0 }
-    }
-}
-
-impl std::ops::Mul<f32> for Term<'_> {
-    type Output = Self;
-    fn mul(mut self, f: f32) -> Self {
-        match &mut self.single {
-            Some((_, w)) => *w *= f,
-            None => self.scale *= f,
-        }
-        self
-    }
-}
-
-impl std::ops::Add for Term<'_> {
-    type Output = Self;
-    fn add(self, other: Self) -> Self {
-        let sink = self.sink.or(other.sink);
-        if let (Some(sink), Some(item)) = (sink, other.single) {
-            sink.borrow_mut().push(item);
-        }
-        Term { sink, single: None, scale: self.scale }
-    }
-}
-
-/// Appends the lookup's (patch, weight) pairs at `p` to `out` and returns
-/// the normalisation factor, or None (nothing appended) where no patch is near.
-fn lookup_weights(solution: &Radiosity, p: glam::Vec3, n: glam::Vec3, out: &mut Vec<(u32, f32)>) -> Option<f32> {
-    let sink = RefCell::new(std::mem::take(out));
-    let before = sink.borrow().len();
-    let scale = solution
-        .lookup()
-        .interpolate(solution.patches(), p, n, |i| Term {
-            sink: Some(&sink),
-            single: Some((i as u32, 1.0)),
-            scale: 1.0,
-        })
-        .map(|t| t.scale);
-    *out = sink.into_inner();
-    if scale.is_none() {
-        out.truncate(before);
-    }
-    scale
 }
 
 #[cfg(test)]
@@ -310,14 +242,5 @@ mod tests {
     fn in_a_medium_too() {
         let text = format!("{CORNELL}\n[medium]\nsigma_a = 0.01\nsigma_s = 0.03\n");
         check(&mut SceneFile::from_toml_str(&text, None).unwrap().scene);
-    }
-
-    #[test]
-    fn terms_follow_the_lookups_sum_and_normalisation() {
-        let sink = RefCell::new(Vec::new());
-        let one = |i: u32| Term { sink: Some(&sink), single: Some((i, 1.0)), scale: 1.0 };
-        let sum = (Term::default() + one(3) * 0.5 + one(7) * 0.25) * 4.0;
-        assert_eq!(sum.scale, 4.0);
-        assert_eq!(sink.borrow().as_slice(), &[(3, 0.5), (7, 0.25)]);
     }
 }

@@ -47,14 +47,33 @@ use patches::Patch;
 use rayon::prelude::*;
 use std::time::{Duration, Instant};
 
-/// Most patches a scene may be cut into (about 2 GB of links at the
-/// default threshold; see docs/radiosity-bench.md).
+/// Most patches a scene may be cut into (about 4 GB of links with patches
+/// alone receiving at the default threshold; see docs/radiosity-bench.md).
 pub const MAX_PATCHES: usize = 2_000_000;
 
-/// Peak bytes of compilation per patch (links collected before packing;
-/// 753 MB at 100,451 patches in docs/radiosity-bench.md), for the
-/// up-front memory check.
-pub const PEAK_BYTES_PER_PATCH: u64 = 8 << 10;
+/// Peak bytes of compilation per patch, for the up-front memory check,
+/// with patches alone receiving (the most links): ~340 packed links of 6
+/// bytes, patch and cluster records, and one block's unpacked links
+/// (docs/radiosity-bench.md). Clusters receiving at
+/// [`LARGE_RECEIVER_SHARE`] peak at a fifth of this (554 MB at 1M patches).
+pub const PEAK_BYTES_PER_PATCH: u64 = 4 << 10;
+
+/// Scenes estimated to cut into more patches than this (both sides of
+/// boxes counted, before culling) let clusters receive by default, with
+/// [`LARGE_RECEIVER_SHARE`]; smaller ones keep patch-only receivers.
+pub const RECEIVER_CLUSTERS_FROM: f64 = 100_000.0;
+
+/// The default receiver share of large scenes. With patches alone as
+/// receivers each patch keeps ~340 links however fine the cut (341 M links,
+/// 2 GB, at 1M patches on the Cornell box); with flat clusters receiving
+/// at 0.1, a patch's far field is shared by its neighbours: 93 links per
+/// patch at 100k, for an area-weighted mean difference of 2.5% in the
+/// one-bounce irradiance from the patch-only solution (the hierarchy
+/// itself differs by 1.8% from the full O(N²) one); see
+/// docs/radiosity-bench.md. Below [`RECEIVER_CLUSTERS_FROM`] receiver
+/// clusters save little (at 7k patches, 0.1 saves a fifth of the links
+/// for a 1.1% difference) and are left off.
+pub const LARGE_RECEIVER_SHARE: f32 = 0.1;
 
 /// Why a scene cannot be compiled.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
@@ -66,6 +85,13 @@ pub enum RadiosityError {
          at most {MAX_PATCHES} are allowed: choose a larger patch_size"
     )]
     TooManyPatches { patch_size: f32, estimated: f64 },
+}
+
+/// How many patches `scene` cuts into at `patch_size`, counting both sides
+/// of boxes and spheres (before culling), without cutting it.
+pub fn estimated_patches(scene: &Scene, patch_size: f32) -> f64 {
+    let square = scene.bounds();
+    scene.objects().iter().map(|(shape, _)| patches::count(shape, patch_size, square)).sum()
 }
 
 thread_local! {
@@ -86,9 +112,11 @@ pub struct CompileParams {
     /// Clusters may receive light too (Hanrahan, Salzman and Aupperle's
     /// two-sided refinement) when flat (normals within ~18°) and their own
     /// estimated form factor is below `receiver_share × link_threshold`; the
-    /// irradiance a cluster gathers is handed down to its patches. 0 (the
-    /// default) lets only patches receive, as Madams does: on the Cornell
-    /// box receiver clusters saved fewer links than they cost in accuracy.
+    /// irradiance a cluster gathers is handed down to its patches. 0 lets
+    /// only patches receive, as Madams does: the default up to
+    /// [`RECEIVER_CLUSTERS_FROM`] patches, where receiver clusters save
+    /// fewer links than they cost in accuracy; larger scenes default to
+    /// [`LARGE_RECEIVER_SHARE`].
     pub receiver_share: f32,
     /// Seeds the clustering and the sample positions.
     pub seed: u64,
@@ -98,16 +126,18 @@ impl CompileParams {
     /// The integrator's options for `scene`; without `patch_size`, 1/32 of
     /// the largest extent of the bounded geometry (1/16 of the scene's
     /// bounding radius when there are only planes). Seeded by the scene's
-    /// seed.
+    /// seed. Clusters receive ([`LARGE_RECEIVER_SHARE`]) when the scene
+    /// cuts into more than [`RECEIVER_CLUSTERS_FROM`] patches.
     pub fn for_scene(scene: &Scene, options: &RadiosityOptions) -> Self {
         let patch_size = options.patch_size.unwrap_or_else(|| match scene.geometry().bounds() {
             Some((lo, hi)) if (hi - lo).max_element() > 0.0 => (hi - lo).max_element() / 32.0,
             _ => scene.bounds().1 / 16.0,
         });
+        let large = estimated_patches(scene, patch_size) > RECEIVER_CLUSTERS_FROM;
         CompileParams {
             patch_size,
             link_threshold: options.link_threshold,
-            receiver_share: 0.0,
+            receiver_share: if large { LARGE_RECEIVER_SHARE } else { 0.0 },
             seed: scene.settings().seed,
         }
     }
@@ -164,8 +194,9 @@ pub struct Radiosity {
     materials: Vec<Material>,
     direct: Vec<Rgb>,
     indirect: Vec<Rgb>,
-    /// Per node (patches, then clusters): radiosity (16-byte aligned for
-    /// the gather's SIMD).
+    /// Per node (patches, then clusters): area, for pushing radiosity up.
+    node_area: Vec<f32>,
+    /// Per node: radiosity (16-byte aligned for the gather's SIMD).
     node_b: Vec<glam::Vec3A>,
     /// Per node: one bounce's gathered irradiance.
     gathered: Vec<Rgb>,
@@ -194,8 +225,7 @@ impl Radiosity {
         let start = Instant::now();
         let mut patches = Vec::new();
         let square = scene.bounds();
-        let estimated: f64 =
-            scene.objects().iter().map(|(shape, _)| patches::count(shape, params.patch_size, square)).sum();
+        let estimated = estimated_patches(scene, params.patch_size);
         if estimated.is_nan() || estimated > MAX_PATCHES as f64 {
             return Err(RadiosityError::TooManyPatches { patch_size: params.patch_size, estimated });
         }
@@ -246,6 +276,7 @@ impl Radiosity {
             materials: Vec::new(),
             direct: vec![Rgb::ZERO; n],
             indirect: vec![Rgb::ZERO; n],
+            node_area: patches.iter().map(|p| p.area).chain(hierarchy.clusters.iter().map(|c| c.area)).collect(),
             node_b: vec![glam::Vec3A::ZERO; nodes],
             gathered: vec![Rgb::ZERO; nodes],
             patches,
@@ -273,7 +304,8 @@ impl Radiosity {
         let per_patch = self.patches.capacity() * size_of::<Patch>()
             + (self.albedo.capacity() + self.direct.capacity() + self.indirect.capacity() + self.gathered.capacity())
                 * size_of::<Rgb>()
-            + self.node_b.capacity() * size_of::<glam::Vec3A>();
+            + self.node_b.capacity() * size_of::<glam::Vec3A>()
+            + self.node_area.capacity() * size_of::<f32>();
         per_patch + self.hierarchy.bytes() + self.links.bytes() + self.lookup.bytes()
     }
 
@@ -303,7 +335,7 @@ impl Radiosity {
             for ((b, a), e) in self.node_b[..n].iter_mut().zip(&self.albedo).zip(source) {
                 *b = (*a * *e).into();
             }
-            lighting::push(&self.patches, &self.hierarchy, &mut self.node_b);
+            lighting::push(&self.node_area, &self.hierarchy, &mut self.node_b);
             times.push += t.elapsed();
             let t = Instant::now();
             lighting::gather(&self.links, &self.node_b, &mut self.gathered);

@@ -101,13 +101,56 @@ fn dimension_seed(seed: u32, i: u32) -> u32 {
     h ^ (h >> 16)
 }
 
+/// The bit-reversed direction numbers of dimensions 1..4 as nibble
+/// tables: entry [d][j][v] is the XOR of reversed vₖ over the set bits b of
+/// v, k = 4j + b. A point's coordinates are then eight table reads per
+/// dimension instead of a step per index bit; bit-reversed, because the
+/// Owen scramble works on the reversed value.
+const NIBBLES: [[[u32; 16]; 8]; 3] = nibble_tables();
+
+const fn nibble_tables() -> [[[u32; 16]; 8]; 3] {
+    let mut t = [[[0u32; 16]; 8]; 3];
+    let mut d = 0;
+    while d < 3 {
+        let mut j = 0;
+        while j < 8 {
+            let mut v = 0;
+            while v < 16 {
+                let mut x = 0u32;
+                let mut b = 0;
+                while b < 4 {
+                    if (v >> b) & 1 == 1 {
+                        x ^= DIRECTIONS[d + 1][4 * j + b].reverse_bits();
+                    }
+                    b += 1;
+                }
+                t[d][j][v] = x;
+                v += 1;
+            }
+            j += 1;
+        }
+        d += 1;
+    }
+    t
+}
+
 /// Point `index` of the shuffled, Owen-scrambled 4D Sobol' sequence with
-/// this seed, each coordinate in [0, 1).
+/// this seed, each coordinate in [0, 1): the same numbers as scrambling
+/// [`sobol`]'s coordinates of the scrambled index with [`owen_scramble`],
+/// computed with the coordinates kept bit-reversed until the end (the
+/// reversed Sobol' point of a scrambled index is its dimension-0 value
+/// itself), which halves the bit reversals.
 pub fn scrambled_sobol4(index: u32, seed: u32) -> [f32; 4] {
-    let point = sobol4(owen_scramble(index, seed));
+    let shuffled = owen_scramble(index, seed);
+    let mut reversed = [shuffled, 0, 0, 0];
+    for (value, table) in reversed[1..].iter_mut().zip(&NIBBLES) {
+        for (j, row) in table.iter().enumerate() {
+            *value ^= row[((shuffled >> (4 * j)) & 15) as usize];
+        }
+    }
     let mut out = [0.0; 4];
     for (d, slot) in out.iter_mut().enumerate() {
-        let x = owen_scramble(point[d], dimension_seed(seed, d as u32));
+        let x = laine_karras(reversed[d], dimension_seed(seed, d as u32)).reverse_bits();
         // The top 24 bits: exact in an f32, strictly below 1.
         *slot = (x >> 8) as f32 * (1.0 / (1u32 << 24) as f32);
     }
@@ -173,6 +216,24 @@ mod tests {
                     count[((a << j) | b) as usize] += 1;
                 }
                 assert!(count.iter().all(|&c| c == 1), "m {m} split {i}+{j}");
+            }
+        }
+    }
+
+    #[test]
+    fn table_form_gives_the_scrambled_points_bit_for_bit() {
+        // The direct form: scramble the index, take its Sobol' point,
+        // scramble each coordinate.
+        for seed in [0u32, 7, 0xdead_beef] {
+            for index in (0..4096u32).chain([u32::MAX, 0x8000_0000, 0x1234_5678]) {
+                let s = owen_scramble(index, seed);
+                let direct: Vec<f32> = (0..4)
+                    .map(|d| {
+                        let x = owen_scramble(sobol(s, d), dimension_seed(seed, d as u32));
+                        (x >> 8) as f32 * (1.0 / (1u32 << 24) as f32)
+                    })
+                    .collect();
+                assert_eq!(scrambled_sobol4(index, seed).to_vec(), direct, "index {index} seed {seed}");
             }
         }
     }

@@ -133,6 +133,10 @@ pub(super) struct Fog<'a> {
     pub closed_form: bool,
 }
 
+/// The key of each light's fixed shift of a bounce's stratified light
+/// numbers ([`direct_light`]).
+const LIGHT_SHIFT_KEY: u64 = 0x5bd1_e995_9e37_79b9;
+
 /// Next-event estimation at a vertex: a sample of every light that reaches
 /// it, with a shadow ray and the medium's transmittance, weighted by the
 /// balance heuristic against sampling the BRDF or phase function (area
@@ -149,6 +153,10 @@ pub(super) fn direct_light(
     sampler: &mut Sampler,
 ) -> Rgb {
     let p = vertex.p();
+    let stratified = match *vertex {
+        Vertex::Surface { light_numbers, .. } => light_numbers,
+        Vertex::Medium { .. } => None,
+    };
     let medium = fog.medium;
     let along = match vertex {
         Vertex::Medium { along, .. } => along.as_ref(),
@@ -157,12 +165,20 @@ pub(super) fn direct_light(
     let key = sampler.next_key();
     let mut total = Rgb::ZERO;
     scene.for_each_light_at(p, |index, light| {
-        let Some(ls) = scene.sample_light(index, p, light_numbers(keyed2(key, index as u64))) else { return };
+        let u = match stratified {
+            // Each light's points shifted by its own fixed offset (mod 1):
+            // still evenly spread, and not the same as another light's.
+            Some(u) => {
+                let shift = keyed2(LIGHT_SHIFT_KEY, index as u64);
+                (u + shift).fract()
+            }
+            None => keyed2(key, index as u64),
+        };
+        let Some(ls) = scene.sample_light(index, p, light_numbers(u)) else { return };
         let (f, scatter_pdf, normal) = match *vertex {
-            Vertex::Surface { p, n, material } => {
-                let m = scene.material(material);
-                let f = m.brdf(p, n, wo, ls.wi) * ls.wi.dot(n).abs();
-                (f, m.pdf(p, n, wo, ls.wi), Some(n))
+            Vertex::Surface { p, n, material: m, .. } => {
+                let (brdf, pdf) = m.eval(p, n, wo, ls.wi);
+                (brdf * ls.wi.dot(n).abs(), pdf, Some(n))
             }
             Vertex::Medium { .. } => {
                 let phase = medium.map_or(0.0, |m| m.phase(wo, ls.wi));

@@ -133,10 +133,23 @@ impl Links {
     }
 }
 
+/// Receivers are refined in blocks of about this many patches (subtrees
+/// of the hierarchy), each packed before the next starts, so that the
+/// unpacked (receiver, link) pairs of only one block are held at a time.
+const BLOCK_PATCHES: u32 = 1 << 15;
+
 /// Builds the links of every node (in parallel; the result does not depend
 /// on the number of threads). `threshold`: see the module documentation;
 /// with threshold 0 every link joins two single patches, the full O(N²)
 /// solution.
+///
+/// Refinement runs once per block of receivers: a subtree T of the
+/// hierarchy, in left-to-right order. Every link of a receiver in T comes
+/// from a pair whose receiver is in T or above it, so a refinement from
+/// (root, root) that follows only the child toward T when it splits a
+/// receiver above T finds exactly T's links (and repeats only the few pairs
+/// above T). The links are the same, bit for bit, as one refinement over
+/// all receivers, and are packed block by block.
 pub fn build(
     patches: &[Patch],
     hierarchy: &Hierarchy,
@@ -144,6 +157,19 @@ pub fn build(
     threshold: f32,
     receiver_share: f32,
     seed: u64,
+) -> Links {
+    build_in_blocks(patches, hierarchy, geometry, threshold, receiver_share, seed, BLOCK_PATCHES)
+}
+
+/// [`build`] with blocks of at most `block_patches` patches.
+fn build_in_blocks(
+    patches: &[Patch],
+    hierarchy: &Hierarchy,
+    geometry: &Geometry,
+    threshold: f32,
+    receiver_share: f32,
+    seed: u64,
+    block_patches: u32,
 ) -> Links {
     let n = patches.len();
     let nodes = n + hierarchy.clusters.len();
@@ -156,44 +182,79 @@ pub fn build(
         cdf.push(acc);
     }
     let ctx = Context { patches, hierarchy, geometry, threshold, receiver_share, seed, cdf: &cdf };
-    let mut pairs = Vec::new();
-    if n > 0 {
-        ctx.refine(hierarchy.root, hierarchy.root, &mut pairs);
-    }
-    // Group by receiver; the sort is stable and `pairs` comes out in one
-    // order whatever the threads, so the links do too.
-    // Sources in increasing order within each receiver, so that gathering
-    // walks the radiosity array forward.
-    pairs.sort_by_key(|&(r, l)| (r, l.source));
     let narrow = nodes <= u16::MAX as usize + 1;
-    let mut offsets = Vec::with_capacity(nodes + 1);
-    let mut wide = Vec::with_capacity(if narrow { 0 } else { pairs.len() });
-    let mut small = Vec::with_capacity(if narrow { pairs.len() } else { 0 });
-    let mut factors = Vec::with_capacity(pairs.len());
-    let mut patch_to_patch = 0;
-    offsets.push(0);
-    let mut k = 0;
-    for r in 0..nodes as u32 {
-        while k < pairs.len() && pairs[k].0 == r {
-            let link = pairs[k].1;
-            if (r as usize) < n && (link.source as usize) < n {
-                patch_to_patch += 1;
-            }
-            if narrow {
-                small.push(link.source as u16);
-            } else {
-                wide.push(link.source);
-            }
-            factors.push(to_bf16(link.factor));
-            k += 1;
+    let mut packer = Packer {
+        n,
+        offsets: Vec::with_capacity(nodes + 1),
+        sources: if narrow { Sources::Narrow(Vec::new()) } else { Sources::Wide(Vec::new()) },
+        factors: Vec::new(),
+        patch_to_patch: 0,
+        next: 0,
+    };
+    packer.offsets.push(0);
+    // Links received by clusters, kept aside until every patch's are
+    // packed (node order: patches first, then clusters).
+    let mut cluster_pairs: Vec<(u32, Link)> = Vec::new();
+    if n > 0 {
+        for block in ctx.blocks(block_patches) {
+            let mut pairs = Vec::new();
+            ctx.refine(hierarchy.root, hierarchy.root, Some(block), &mut pairs);
+            // (receiver, source) pairs are unique, so this order is one
+            // whatever the threads. Sources increase within each receiver,
+            // so that gathering walks the radiosity array forward.
+            pairs.sort_unstable_by_key(|&(r, l)| (r, l.source));
+            let split = pairs.partition_point(|&(r, _)| (r as usize) < n);
+            cluster_pairs.extend_from_slice(&pairs[split..]);
+            pairs.truncate(split);
+            packer.pack(&pairs, ctx.node(block).end);
         }
-        offsets.push(factors.len() as u32);
+        cluster_pairs.sort_unstable_by_key(|&(r, l)| (r, l.source));
+        packer.pack(&cluster_pairs, nodes as u32);
     }
-    Links {
-        offsets,
-        sources: if narrow { Sources::Narrow(small) } else { Sources::Wide(wide) },
-        factors,
-        patch_to_patch,
+    let Packer { mut offsets, mut sources, mut factors, patch_to_patch, .. } = packer;
+    // Grown by doubling; give back the slack (a few hundred MB at 1M patches).
+    offsets.shrink_to_fit();
+    factors.shrink_to_fit();
+    match &mut sources {
+        Sources::Narrow(s) => s.shrink_to_fit(),
+        Sources::Wide(s) => s.shrink_to_fit(),
+    }
+    Links { offsets, sources, factors, patch_to_patch }
+}
+
+/// Appends sorted (receiver, link) pairs to the packed form.
+struct Packer {
+    n: usize,
+    offsets: Vec<u32>,
+    sources: Sources,
+    factors: Vec<u16>,
+    patch_to_patch: usize,
+    /// The next receiver whose offset is to be written.
+    next: u32,
+}
+
+impl Packer {
+    /// Packs `pairs` (sorted, receivers from `self.next` on, below `end`)
+    /// and closes receivers up to `end`.
+    fn pack(&mut self, pairs: &[(u32, Link)], end: u32) {
+        let mut k = 0;
+        for r in self.next..end {
+            while k < pairs.len() && pairs[k].0 == r {
+                let link = pairs[k].1;
+                if (r as usize) < self.n && (link.source as usize) < self.n {
+                    self.patch_to_patch += 1;
+                }
+                match &mut self.sources {
+                    Sources::Narrow(s) => s.push(link.source as u16),
+                    Sources::Wide(s) => s.push(link.source),
+                }
+                self.factors.push(to_bf16(link.factor));
+                k += 1;
+            }
+            self.offsets.push(self.factors.len() as u32);
+        }
+        debug_assert_eq!(k, pairs.len(), "pairs outside the block");
+        self.next = end;
     }
 }
 
@@ -264,9 +325,34 @@ impl Context<'_> {
         &self.hierarchy.children[first..first + c.child_count as usize]
     }
 
+    /// The hierarchy's subtrees holding at most `most` patches whose
+    /// parents hold more, left to right: their patch ranges tile 0..n in
+    /// order.
+    fn blocks(&self, most: u32) -> Vec<u32> {
+        let mut out = Vec::new();
+        let mut stack = vec![self.hierarchy.root];
+        while let Some(id) = stack.pop() {
+            let node = self.node(id);
+            if node.leaf || node.end - node.start <= most {
+                out.push(id);
+            } else {
+                stack.extend(self.children(id).iter().rev());
+            }
+        }
+        out
+    }
+
+    /// Whether node `x`'s patches include all of `block`'s.
+    fn covers(&self, x: &Node, block: &Node) -> bool {
+        x.start <= block.start && block.end <= x.end
+    }
+
     /// Links receiver `r` to source `s`, or their parts to each other
-    /// (Hanrahan, Salzman and Aupperle's Refine, with clusters).
-    fn refine(&self, r: u32, s: u32, out: &mut Vec<(u32, Link)>) {
+    /// (Hanrahan, Salzman and Aupperle's Refine, with clusters). With
+    /// `block`, only the links of receivers in that subtree (and of
+    /// receivers above it whose leftmost block it is) are made; `r` must
+    /// then lie in the block or above it.
+    fn refine(&self, r: u32, s: u32, block: Option<u32>, out: &mut Vec<(u32, Link)>) {
         let (a, b) = (self.node(r), self.node(s));
         if r == s && a.leaf {
             return;
@@ -274,6 +360,10 @@ impl Context<'_> {
         if behind(&a, &b) || behind(&b, &a) {
             return;
         }
+        // Above the block (a strict ancestor of it): r's own links belong
+        // to the block holding its first patch; splitting r follows the
+        // child toward the block only.
+        let above = block.filter(|&t| t != r).map(|t| self.node(t));
         if a.leaf && b.leaf {
             let (i, j) = (r as usize, s as usize);
             let f = form_factor(&self.patches[i], &self.patches[j]);
@@ -292,13 +382,24 @@ impl Context<'_> {
         let receiver_ok = a.leaf || (a.cone_cos >= COHERENT && a.area < limit * self.receiver_share && separated);
         let source_ok = b.leaf || (b.area < limit && separated);
         if receiver_ok && source_ok {
-            let f = self.cluster_factor(r, &a, s, &b);
-            if f > 0.0 {
-                out.push((r, Link { source: s, factor: f }));
+            if above.is_none_or(|t| t.start == a.start) {
+                let f = self.cluster_factor(r, &a, s, &b);
+                if f > 0.0 {
+                    out.push((r, Link { source: s, factor: f }));
+                }
             }
             return;
         }
         let split_receiver = if !receiver_ok && !source_ok { a.area > b.area } else { !receiver_ok };
+        if let (true, Some(t)) = (split_receiver, above) {
+            let toward = self.children(r).iter().copied().find(|&k| self.covers(&self.node(k), &t));
+            if let Some(k) = toward {
+                self.refine(k, s, block, out);
+            }
+            return;
+        }
+        // Below the block's top the restriction no longer matters.
+        let block = if above.is_some() { block } else { None };
         let kids = self.children(if split_receiver { r } else { s });
         let pair = |k: u32| if split_receiver { (k, s) } else { (r, k) };
         if (a.end - a.start) + (b.end - b.start) > PARALLEL {
@@ -307,7 +408,7 @@ impl Context<'_> {
                 .map(|&k| {
                     let mut v = Vec::new();
                     let (x, y) = pair(k);
-                    self.refine(x, y, &mut v);
+                    self.refine(x, y, block, &mut v);
                     v
                 })
                 .collect();
@@ -317,18 +418,20 @@ impl Context<'_> {
         } else {
             for &k in kids {
                 let (x, y) = pair(k);
-                self.refine(x, y, out);
+                self.refine(x, y, block, out);
             }
         }
     }
 
     /// The patch under node `node` whose area interval holds the fraction
-    /// `u` of the node's area.
+    /// `u` of the node's area: the first i in start..end with
+    /// cdf[i + 1] > target (the last when none is). Searched from the
+    /// index that equal areas would give, stepping to the answer: a
+    /// cluster's patches have nearly equal areas, so this takes a step or
+    /// two where a binary search over a large cluster took twenty cache
+    /// misses (it was the costliest part of compiling at 100k patches).
     fn pick(&self, node: &Node, u: f64) -> usize {
-        let (lo, hi) = (self.cdf[node.start as usize], self.cdf[node.end as usize]);
-        let target = lo + u * (hi - lo);
-        let range = &self.cdf[node.start as usize + 1..=node.end as usize];
-        (node.start as usize + range.partition_point(|&x| x <= target)).min(node.end as usize - 1)
+        pick(self.cdf, node.start as usize, node.end as usize, u)
     }
 
     /// A_s · (1/M) Σ_m G(x_m, y_m) V(x_m, y_m), x_m and y_m patch centres
@@ -354,6 +457,22 @@ impl Context<'_> {
     }
 }
 
+/// See [`Context::pick`]: the patch in start..end (start < end) whose
+/// interval of the prefix sums `cdf` holds the fraction `u` of their span.
+fn pick(cdf: &[f64], start: usize, end: usize, u: f64) -> usize {
+    let (lo, hi) = (cdf[start], cdf[end]);
+    let target = lo + u * (hi - lo);
+    let guess = start + ((u * (end - start) as f64) as usize);
+    let mut i = guess.clamp(start, end - 1);
+    while i > start && cdf[i] > target {
+        i -= 1;
+    }
+    while i < end - 1 && cdf[i + 1] <= target {
+        i += 1;
+    }
+    i
+}
+
 /// Whether every point of `b` lies behind (or on) every patch of `a`:
 /// n_x · (y − x) ≤ 0 for all patches x of a with normal n_x and points y of
 /// b. Bounded by n̄·(c_b − c_a) + (b's extent along n̄) + a's half
@@ -366,3 +485,6 @@ fn behind(a: &Node, b: &Node) -> bool {
     let bound = a.normal.dot(d) + extent + a.half_thickness + spread * (d.length() + a.radius + b.radius);
     bound <= 1e-5 * (d.length() + a.radius + b.radius)
 }
+
+#[cfg(test)]
+mod tests;
