@@ -333,7 +333,7 @@ fn check_with(seed: u64, render_seed: u64) -> Result<Vec<(&'static str, f64)>, S
 }
 
 /// XORed into a scene's seed for its second render (see [`run`]).
-const RETRY_SEED: u64 = 0x5eed_0f_a11;
+const RETRY_SEED: u64 = 0x5_eed0_fa11;
 
 fn run(count: u64) {
     let seeds: Vec<u64> = match std::env::var("AIRLIGHT_DIFF_SEED").ok().and_then(|s| s.parse().ok()) {
