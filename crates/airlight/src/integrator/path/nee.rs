@@ -203,7 +203,9 @@ pub(super) fn direct_light(
             // still evenly spread, and not the same as another light's.
             Some(u) => {
                 let shift = keyed2(LIGHT_SHIFT_KEY, index as u64);
-                (u + shift).fract()
+                // u + shift is in [0, 2): its fractional part without
+                // `trunc` (a libm call per number), the same value.
+                (u + shift).map(|x| if x >= 1.0 { x - 1.0 } else { x })
             }
             None => keyed2(key, index as u64),
         };
