@@ -282,7 +282,7 @@ mod tests {
                 values.push(-m * scale);
             }
         }
-        values.extend([0.0, -0.0, f32::MAX, -f32::MAX, f32::MIN_POSITIVE, 1e-45]);
+        values.extend([0.0, -0.0, f32::MAX, -f32::MAX, f32::MIN_POSITIVE, f32::from_bits(1)]);
         for x in values {
             let x = x as f64;
             for (value, bits) in [(x, SUM_FRACTION_BITS), (x * x, SQUARE_FRACTION_BITS), (x, 0), (x * x, 0)] {
