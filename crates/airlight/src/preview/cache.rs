@@ -152,7 +152,8 @@ impl FirstSample {
             let mut block = Block::new();
             for x0 in (0..w).step_by(band) {
                 block.select(x0, b * band, w, texels.len() / w);
-                (block.rays.clear(), block.samplers.clear());
+                block.rays.clear();
+                block.samplers.clear();
                 for &(x, y, _) in &block.pixels {
                     let mut sampler = first_sampler(scene, (y * w + x) as u64);
                     block.rays.push(camera_ray(scene, &camera, (x, y), &mut sampler));
@@ -232,7 +233,8 @@ impl Shading<'_> {
         let medium = scene.medium();
         // The surface each ray's light leaves: a light's in front of the
         // objects (it reflects nothing), or the object's; and how far.
-        (rays.clear(), surfaces.clear());
+        rays.clear();
+        surfaces.clear();
         let mut ends = [(0.0f32, false); BLOCK_ORDER.len()];
         for (k, &(_, _, i)) in pixels.iter().enumerate() {
             let texel = &texels[i];
