@@ -74,29 +74,60 @@ impl Camera {
     /// the image, x right, y down) of a `width`×`height` image, through lens
     /// point `lens` (uniform in [0, 1)²; unused by a pinhole).
     pub fn ray(&self, film: Vec2, width: u32, height: u32, lens: Vec2) -> Ray {
-        let aspect = width as f32 / height as f32;
-        let ndc_x = 2.0 * film.x / width as f32 - 1.0;
-        let ndc_y = 1.0 - 2.0 * film.y / height as f32;
-        let (origin, dir) = match self.projection {
-            Projection::Perspective { fov_degrees } => {
-                let half = (0.5 * fov_degrees.to_radians()).tan();
-                let d = self.forward + self.right * (ndc_x * half * aspect) + self.up * (ndc_y * half);
-                (self.position, d.normalize())
+        self.film(width, height).ray(film, lens)
+    }
+
+    /// The camera's rays through the film of a `width`×`height` image, with
+    /// what every ray shares worked out once (the field of view's tangent).
+    pub fn film(&self, width: u32, height: u32) -> CameraFilm {
+        let half = match self.projection {
+            Projection::Perspective { fov_degrees } => (0.5 * fov_degrees.to_radians()).tan(),
+            Projection::Orthographic { view_height } => 0.5 * view_height,
+        };
+        CameraFilm { camera: *self, width: width as f32, height: height as f32, half }
+    }
+}
+
+/// A [`Camera`] over an image of a given size ([`Camera::film`]): the same
+/// rays as [`Camera::ray`], bit for bit, for a render's millions of them.
+#[derive(Clone, Copy, Debug)]
+pub struct CameraFilm {
+    camera: Camera,
+    width: f32,
+    height: f32,
+    /// Half the image's height on the plane at distance 1 (perspective) or
+    /// in world units (orthographic).
+    half: f32,
+}
+
+impl CameraFilm {
+    /// The ray through film point `film` and lens point `lens`, as
+    /// [`Camera::ray`] describes.
+    #[inline]
+    pub fn ray(&self, film: Vec2, lens: Vec2) -> Ray {
+        let c = &self.camera;
+        let aspect = self.width / self.height;
+        let ndc_x = 2.0 * film.x / self.width - 1.0;
+        let ndc_y = 1.0 - 2.0 * film.y / self.height;
+        let half = self.half;
+        let (origin, dir) = match c.projection {
+            Projection::Perspective { .. } => {
+                let d = c.forward + c.right * (ndc_x * half * aspect) + c.up * (ndc_y * half);
+                (c.position, d.normalize())
             }
-            Projection::Orthographic { view_height } => {
-                let half = 0.5 * view_height;
-                let o = self.position + self.right * (ndc_x * half * aspect) + self.up * (ndc_y * half);
-                (o, self.forward)
+            Projection::Orthographic { .. } => {
+                let o = c.position + c.right * (ndc_x * half * aspect) + c.up * (ndc_y * half);
+                (o, c.forward)
             }
         };
-        if self.aperture <= 0.0 {
+        if c.aperture <= 0.0 {
             return Ray::new(origin, dir);
         }
         // Thin lens: all rays through one film point meet again on the plane
         // of focus, perpendicular to the view axis.
-        let focus = origin + dir * (self.focus_distance / dir.dot(self.forward));
-        let disk = concentric_disk(lens) * self.aperture;
-        let lens_point = origin + self.right * disk.x + self.up * disk.y;
+        let focus = origin + dir * (c.focus_distance / dir.dot(c.forward));
+        let disk = concentric_disk(lens) * c.aperture;
+        let lens_point = origin + c.right * disk.x + c.up * disk.y;
         Ray::new(lens_point, (focus - lens_point).normalize())
     }
 }

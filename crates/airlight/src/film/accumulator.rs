@@ -35,12 +35,25 @@ pub struct PixelSum {
     pub count: u64,
 }
 
-/// `x · 2^bits` rounded to the nearest integer; saturates at the ends of
-/// `i128` (Rust's float-to-int cast does), so no input overflows.
+/// `x · 2^bits` rounded to the nearest integer, halves away from zero;
+/// saturates at the ends of `i128` (Rust's float-to-int cast does), so no
+/// input overflows.
 #[inline]
 fn to_fixed(x: f64, bits: i32) -> i128 {
-    (x * 2f64.powi(bits)).round() as i128
+    let y = x * 2f64.powi(bits);
+    if y.abs() < TWO_POW_62 {
+        // What `y.round() as i128` gives, by the processor's truncating
+        // conversion (f64::round and i128 casts are library calls on
+        // x86-64's baseline): y − trunc(y) is exact.
+        let i = y as i64;
+        let fraction = y - i as f64;
+        (i + (fraction >= 0.5) as i64 - (fraction <= -0.5) as i64) as i128
+    } else {
+        y.round() as i128
+    }
 }
+
+const TWO_POW_62: f64 = (1u64 << 62) as f64;
 
 #[inline]
 fn from_fixed(x: i128, bits: i32) -> f64 {
@@ -245,6 +258,22 @@ mod tests {
                 Rgb::new(u * 2f32.powi(octave), u, 1.0 - u)
             })
             .collect()
+    }
+
+    #[test]
+    fn to_fixed_rounds_as_f64_round_does() {
+        let mut values = vec![0.5, -0.5, 1.5, -1.5, 2.5, 0.49999999999999994, -0.49999999999999994, 0.0, -0.0];
+        values.extend([2f64.powi(51) + 0.5, -(2f64.powi(51) + 0.5), 2f64.powi(62), -(2f64.powi(62)), 1e300, f64::NAN]);
+        values.extend([f64::INFINITY, f64::NEG_INFINITY, 2f64.powi(62) - 512.0, -(2f64.powi(62) - 512.0)]);
+        // Renderer-like values over many octaves, with every kind of fraction.
+        let renderer_like = samples(2000).into_iter().flat_map(|x| x.to_array());
+        values.extend(renderer_like.flat_map(|x| [x as f64, -(x as f64) * 1e3, x as f64 * 3e9]));
+        for &x in &values {
+            for bits in [0, SUM_FRACTION_BITS, SQUARE_FRACTION_BITS] {
+                let scaled = x / 2f64.powi(bits);
+                assert_eq!(to_fixed(scaled, bits), (scaled * 2f64.powi(bits)).round() as i128, "{x} at {bits} bits");
+            }
+        }
     }
 
     #[test]
