@@ -45,8 +45,7 @@ impl Timing {
             t if t < 1.0 => format!("{t:.3} s"),
             t => format!("{t:.2} s"),
         };
-        let layers =
-            if self.layers.is_zero() { String::new() } else { format!(", AOV layers {}", s(self.layers)) };
+        let layers = if self.layers.is_zero() { String::new() } else { format!(", AOV layers {}", s(self.layers)) };
         format!("{} (image {}{layers}, writing {}, setup {})", s(total), s(self.image), s(self.writing), s(setup))
     }
 }
@@ -61,7 +60,10 @@ mod tests {
         let mut timing = Timing { image: ms(400), layers: Duration::ZERO, writing: ms(190) };
         assert_eq!(timing.summary(ms(611)), "0.611 s (image 0.400 s, writing 0.190 s, setup 0.021 s)");
         timing.layers = ms(1500);
-        assert_eq!(timing.summary(ms(2100)), "2.10 s (image 0.400 s, AOV layers 1.50 s, writing 0.190 s, setup 0.010 s)");
+        assert_eq!(
+            timing.summary(ms(2100)),
+            "2.10 s (image 0.400 s, AOV layers 1.50 s, writing 0.190 s, setup 0.010 s)"
+        );
         let counted = timing.image(|| 7);
         assert_eq!(counted, 7, "the closure's result is passed on");
     }

@@ -76,11 +76,9 @@ impl std::fmt::Debug for Shape {
                     .finish()
             }
             Shape::Sdf(sdf) => f.debug_tuple("Sdf").field(sdf).finish(),
-            Shape::Transformed { shape, world_from_local } => f
-                .debug_struct("Transformed")
-                .field("shape", shape)
-                .field("world_from_local", world_from_local)
-                .finish(),
+            Shape::Transformed { shape, world_from_local } => {
+                f.debug_struct("Transformed").field("shape", shape).field("world_from_local", world_from_local).finish()
+            }
         }
     }
 }
