@@ -94,9 +94,9 @@ pub fn accumulate(
     let rows = acc.rows();
     // Each tile gets its rows of the accumulator's pixels (disjoint slices)
     // and adds its samples there: no copy, no second image-sized buffer.
-    let mut tiles: Vec<((u32, u32), Vec<&mut [PixelSum]>)> = Vec::new();
+    let mut tiles: Vec<((u32, u32), TileRows)> = Vec::new();
     for (ty, band) in acc.pixels_mut().chunks_mut((TILE * w) as usize).enumerate() {
-        let mut band_tiles: Vec<Vec<&mut [PixelSum]>> = (0..w.div_ceil(TILE)).map(|_| Vec::new()).collect();
+        let mut band_tiles: Vec<TileRows> = (0..w.div_ceil(TILE)).map(|_| Vec::new()).collect();
         for row in band.chunks_mut(w as usize) {
             for (tile, part) in band_tiles.iter_mut().zip(row.chunks_mut(TILE as usize)) {
                 tile.push(part);
@@ -117,6 +117,9 @@ pub fn accumulate(
     });
     acc
 }
+
+/// A tile's rows of the accumulator's pixel sums, top row first.
+type TileRows<'a> = Vec<&'a mut [PixelSum]>;
 
 /// Adds the samples `samples` of the pixels of the tile whose top-left
 /// pixel is (x0, y0) into `tile`, its rows of pixel sums. The samples of
