@@ -95,9 +95,10 @@ pub fn accumulate(
     // Each tile gets its rows of the accumulator's pixels (disjoint slices)
     // and adds its samples there: no copy, no second image-sized buffer.
     let mut tiles: Vec<((u32, u32), TileRows)> = Vec::new();
-    for (ty, band) in acc.pixels_mut().chunks_mut((TILE * w) as usize).enumerate() {
+    // (`max(1)`: an image 0 pixels wide has no pixels and no tiles.)
+    for (ty, band) in acc.pixels_mut().chunks_mut((TILE * w).max(1) as usize).enumerate() {
         let mut band_tiles: Vec<TileRows> = (0..w.div_ceil(TILE)).map(|_| Vec::new()).collect();
-        for row in band.chunks_mut(w as usize) {
+        for row in band.chunks_mut(w.max(1) as usize) {
             for (tile, part) in band_tiles.iter_mut().zip(row.chunks_mut(TILE as usize)) {
                 tile.push(part);
             }
