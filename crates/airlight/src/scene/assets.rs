@@ -22,6 +22,10 @@ pub const MAX_MESH_BYTES: u64 = 1 << 30;
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct AssetPath {
     folders: Vec<PathBuf>,
+    /// A path typed on the command line: the user's own, so any file they
+    /// can read, absolute or relative to the working directory, not only
+    /// what lies inside the folders.
+    command_line: bool,
 }
 
 impl AssetPath {
@@ -29,7 +33,15 @@ impl AssetPath {
     pub fn new(scene_dir: Option<&Path>, extra: &[PathBuf]) -> Self {
         let scene_dir = scene_dir.filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
         let folders = std::iter::once(scene_dir.to_path_buf()).chain(extra.iter().cloned()).collect();
-        AssetPath { folders }
+        AssetPath { folders, command_line: false }
+    }
+
+    /// The paths of a command-line option (`--medium type="grid",file=…`):
+    /// any regular file, absolute or relative to the working directory. The
+    /// limits above guard against scene authors, and the user who types the
+    /// command is not one.
+    pub fn command_line() -> Self {
+        AssetPath { folders: vec![PathBuf::from(".")], command_line: true }
     }
 
     /// The folders listed in `AIRLIGHT_ASSET_PATH`, if set.
@@ -46,6 +58,13 @@ impl AssetPath {
     /// The file `name` stands for, with symbolic links resolved; or why
     /// not (see the module documentation).
     pub fn resolve(&self, name: &str) -> Result<PathBuf, String> {
+        if self.command_line {
+            return match Path::new(name).canonicalize() {
+                Ok(found) if found.is_file() => Ok(found),
+                Ok(_) => Err(format!("`{name}` is not a file")),
+                Err(e) => Err(format!("cannot open `{name}` (relative to the working directory): {e}")),
+            };
+        }
         let relative = Path::new(name);
         let plain = !name.is_empty()
             && !name.contains('\0')
@@ -135,6 +154,24 @@ mod tests {
         assert_eq!(message("out.obj"), missing);
         assert_eq!(message("dangling.obj"), missing);
         assert_eq!(message("meshes"), missing);
+    }
+
+    #[test]
+    fn a_command_line_path_may_be_absolute_or_relative_to_the_working_directory() {
+        let root = tempfile::tempdir().unwrap();
+        let file = root.path().join("cloud.vol");
+        std::fs::write(&file, "").unwrap();
+        let path = AssetPath::command_line();
+        let name = file.to_str().unwrap();
+        assert_eq!(path.resolve(name).unwrap(), file.canonicalize().unwrap());
+        // Cargo runs a test in its package's folder.
+        assert!(path.resolve("Cargo.toml").unwrap().ends_with("crates/airlight/Cargo.toml"));
+        let e = path.resolve("missing.vol").unwrap_err();
+        assert!(e.starts_with("cannot open `missing.vol` (relative to the working directory)"), "{e}");
+        assert_eq!(
+            path.resolve(root.path().to_str().unwrap()).unwrap_err(),
+            format!("`{}` is not a file", root.path().display())
+        );
     }
 
     #[test]

@@ -17,13 +17,15 @@ use toml::Spanned;
 /// one line, `key = value` pairs separated by commas (`sigma_s = 0.05,
 /// sigma_a = 0.01, g = 0.3`; colours as `[r, g, b]`; `type = "height"`),
 /// checked by the same rules as the table. For command lines, which give
-/// a medium without a scene file; a message without a line number.
+/// a medium without a scene file; a message without a line number. A
+/// grid's `file` is any file the user can read, absolute or relative to
+/// the working directory ([`AssetPath::command_line`]).
 pub fn medium_from_options(options: &str) -> Result<Medium, String> {
     let text = format!("medium = {{ {options} }}");
     let strip = |e: SceneError| e.message;
     let desc: SceneDesc = parse(&text).map_err(strip)?;
     let Some(medium) = &desc.medium else { return Err("no medium".into()) };
-    let assets = AssetPath::new(None, &[]);
+    let assets = AssetPath::command_line();
     let checker = Checker {
         text: &text,
         assets: &assets,

@@ -260,11 +260,21 @@ impl Integrator for PathTracer {
     }
 }
 
-/// Russian roulette after the first bounce, on the path's weight: false if
-/// the path ends, else `beta` is raised to keep the estimate unbiased.
+/// The scattering event from which Russian roulette may end a path, as
+/// Mitsuba 3's default `rr_depth`. Measured against starting at the 2nd
+/// event (512 spp Cornell box, 128 spp fog scenes; time × error², seeds 0
+/// and 1): the Cornell box 1.31× more efficient, the hard spot in fog
+/// 1.07×, the point light in fog 0.92× (10% more time per sample). The
+/// early events of a closed room carry much of its light; killing them
+/// costs more in noise than it saves in time.
+const RUSSIAN_ROULETTE_FROM: u32 = 5;
+
+/// Russian roulette from event [`RUSSIAN_ROULETTE_FROM`] on, on the path's
+/// weight: false if the path ends, else `beta` is raised to keep the
+/// estimate unbiased.
 fn russian_roulette(beta: &mut Rgb, r_u: Rgb, depth: u32, sampler: &mut Sampler) -> bool {
     let rr = (*beta / avg(r_u)).max_element();
-    if rr < 1.0 && depth > 1 {
+    if rr < 1.0 && depth >= RUSSIAN_ROULETTE_FROM {
         let q = (1.0 - rr).max(0.0);
         if sampler.next() < q {
             return false;
