@@ -125,11 +125,11 @@ impl Integrator for PathTracer {
                 // Delta lights' light scattered along the segment, also from
                 // equiangular points (nee.rs), when a scattering event here
                 // would still count.
-                let segment = Segment { ray, length: t_medium };
+                let mut segment = Segment::new(ray, t_medium);
                 let equiangular =
                     self.equiangular && self.closed_form && depth < self.max_depth && equiangular_applies(m);
                 if equiangular {
-                    l += equiangular_light(scene, m, &segment, beta, r_u, hero, sampler);
+                    l += equiangular_light(scene, m, &mut segment, beta, r_u, hero, sampler);
                 }
                 let mut scattered: Option<Ray> = None;
                 let mut terminated = false;

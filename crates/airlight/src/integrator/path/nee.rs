@@ -35,15 +35,29 @@ use crate::scene::Scene;
 use crate::scene::light_numbers;
 use glam::Vec3;
 
+/// How many lights' equiangular distributions a segment keeps for the
+/// collision's next-event estimate (the others are computed again).
+const KEPT_DISTRIBUTIONS: usize = 4;
+
 /// A ray's stretch [0, length] through a medium with a closed-form
 /// optical depth.
 #[derive(Clone, Copy)]
 pub(super) struct Segment {
     pub ray: Ray,
     pub length: f32,
+    /// The equiangular distributions of lights 0..KEPT_DISTRIBUTIONS, as
+    /// [`equiangular_light`] computes them: a collision on the segment
+    /// needs the same ones for its balance heuristic ([`direct_light`]),
+    /// and each costs an f64 `atan2` and a square root. None: not yet
+    /// computed, or none applies.
+    kept: [Option<Equiangular>; KEPT_DISTRIBUTIONS],
 }
 
 impl Segment {
+    pub fn new(ray: Ray, length: f32) -> Self {
+        Segment { ray, length, kept: [None; KEPT_DISTRIBUTIONS] }
+    }
+
     /// The equiangular distribution of the segment about `light`, for the
     /// lights it applies to: point, spot and line lights (delta lights with
     /// a place; a line's centre, spread by its length).
@@ -53,6 +67,25 @@ impl Segment {
         }
         let (y, spread) = light.anchor()?;
         Some(Equiangular::new(self.ray.origin, self.ray.dir, y, spread, 0.0, self.length))
+    }
+
+    /// [`Segment::equiangular`] for light `index`, computed once and kept
+    /// if the index is among the kept ones.
+    fn equiangular_kept(&mut self, index: usize, light: &Light) -> Option<Equiangular> {
+        let distribution = self.equiangular(light);
+        if let Some(slot) = self.kept.get_mut(index) {
+            *slot = distribution;
+        }
+        distribution
+    }
+
+    /// [`Segment::equiangular`] for light `index`: the kept one if
+    /// [`equiangular_light`] computed it (the same numbers), else computed.
+    fn equiangular_of(&self, index: usize, light: &Light) -> Option<Equiangular> {
+        match self.kept.get(index) {
+            Some(Some(kept)) => Some(*kept),
+            _ => self.equiangular(light),
+        }
     }
 
     /// Whether the segment passes within `radius` of `center`.
@@ -79,7 +112,7 @@ pub(super) struct Along<'a> {
 pub(super) fn equiangular_light(
     scene: &Scene,
     medium: &Medium,
-    segment: &Segment,
+    segment: &mut Segment,
     beta: Rgb,
     r_u: Rgb,
     hero: usize,
@@ -89,7 +122,7 @@ pub(super) fn equiangular_light(
     let wo = -segment.ray.dir;
     let mut total = Rgb::ZERO;
     for (index, light) in scene.lights().iter().enumerate() {
-        let Some(equiangular) = segment.equiangular(light) else { continue };
+        let Some(equiangular) = segment.equiangular_kept(index, light) else { continue };
         if light.reach().is_some_and(|(center, radius)| !segment.passes_within(center, radius)) {
             continue;
         }
@@ -170,7 +203,9 @@ pub(super) fn direct_light(
             // still evenly spread, and not the same as another light's.
             Some(u) => {
                 let shift = keyed2(LIGHT_SHIFT_KEY, index as u64);
-                (u + shift).fract()
+                // u + shift is in [0, 2): its fractional part without
+                // `trunc` (a libm call per number), the same value.
+                (u + shift).map(|x| if x >= 1.0 { x - 1.0 } else { x })
             }
             None => keyed2(key, index as u64),
         };
@@ -235,7 +270,7 @@ pub(super) fn direct_light(
             // collision or, on the same segment, from an equiangular point.
             let mut denominator = avg(r_p * r_l);
             if let Some(along) = along
-                && let Some(equiangular) = along.segment.equiangular(light)
+                && let Some(equiangular) = along.segment.equiangular_of(index, light)
             {
                 denominator += avg(along.r_equiangular * r_l) * equiangular.pdf(along.t);
             }
