@@ -24,9 +24,13 @@ vectorised wavefronts, JIT-compiled by LLVM; Debian 12's LLVM 15 crashes it,
 LLVM 19 works) and `scalar_rgb`, each timed in the same run. In the llvm
 variants `mi.render` only records the computation: the time is taken
 around `mi.render`, `dr.eval` and `dr.sync_thread`, after a first render
-with another seed that compiles the kernels. Airlight's time is the one
-`airlight render` reports (after the scene is loaded and its BVH built, as
-Mitsuba's excludes `load_dict`).
+with another seed that compiles the kernels: no scene loading, no file
+writing. Airlight's time, to compare like with like, is the "image" part of
+what `airlight render` reports: the samples of every pixel rendered into
+the image, after the scene is loaded and its BVH built (as Mitsuba's
+excludes `load_dict`), without building the integrator, the preflight
+probe or writing the EXR. Airlight's whole command after loading (those
+included) is printed beside it as "command".
 
 Conventions matched (docs/scene-format.md): intensities in W/sr, radiance for
 area lights; a pixel is the box-filtered mean; Mitsuba's max_depth counts
@@ -230,10 +234,15 @@ def airlight(*args):
 
 
 def render_seconds(stderr):
-    """The render time `airlight render` reports ("rendered ... in T s")."""
+    """The times `airlight render` reports ("rendered ... in T s (image I s,
+    writing W s, setup S s)"): (I, T), the image's samples alone and the
+    whole command after loading the scene."""
     for line in stderr.splitlines():
         if line.startswith("rendered ") and " in " in line:
-            return float(line.split(" in ")[1].split()[0])
+            total = float(line.split(" in ")[1].split()[0])
+            if "(image " not in line:
+                raise SystemExit(f"airlight render did not report the image's time apart (an older binary?): {line}")
+            return float(line.split("(image ")[1].split()[0]), total
     raise SystemExit(f"airlight render reported no time: {stderr.strip()}")
 
 
@@ -279,11 +288,14 @@ def main():
         ours = os.path.join(args.out, f"{name}.airlight.exr")
         other = os.path.join(args.out, f"{name}.airlight-seed1.exr")
         common = ["render", path, "--integrator", integrator, "--spp", str(args.spp)]
-        airlight_seconds = render_seconds(airlight(*common, "-o", ours)[1])
+        airlight_seconds, airlight_command = render_seconds(airlight(*common, "-o", ours)[1])
         airlight(*common, "--seed", "1", "-o", other, "--quiet")
         noise = airlight("compare", ours, other)[0]
         e_a = field(noise, "rel_rmse") / math.sqrt(2)
-        print(f"{name}: {args.spp} spp, {integrator}; Airlight {airlight_seconds:.3f} s, own error {e_a:.4f}")
+        print(
+            f"{name}: {args.spp} spp, {integrator}; Airlight {airlight_seconds:.3f} s "
+            f"(command {airlight_command:.3f} s), own error {e_a:.4f}"
+        )
         for variant in variants:
             mi.set_variant(variant)
             scene_dict, _, _ = translate(path, args.spp, args.mitsuba_sampler)

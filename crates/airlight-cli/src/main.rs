@@ -19,6 +19,7 @@ mod progress;
 mod render;
 mod study;
 mod submit;
+mod timing;
 mod view;
 
 /// The built-in demo scene: spheres on a checker floor under a spot light in fog.

@@ -7,6 +7,7 @@ use crate::aovs::Layers;
 use crate::load;
 use crate::preflight::Forecast;
 use crate::progress::Progress;
+use crate::timing::Timing;
 use airlight::SceneFile;
 use airlight::aov::Aov;
 use airlight::film::Image;
@@ -232,6 +233,7 @@ pub fn render(args: RenderArgs) -> Result<(), String> {
     let forecast = Forecast::new(plan.work(&scene), what, probe.is_some());
     let progress = Progress::new(plan.work(&scene), args.quiet).with_forecast(forecast);
     let mut written = Vec::new();
+    let mut timing = Timing::default();
     let frames: Vec<Option<(u32, u32)>> = match &plan.frames {
         Some((list, n)) => list.iter().map(|&k| Some((k, *n))).collect(),
         None => vec![None],
@@ -249,10 +251,14 @@ pub fn render(args: RenderArgs) -> Result<(), String> {
             }
             None => FrameOutputs { images: outputs.clone(), variance: args.variance.clone(), layers: Layers::none() },
         };
+        let layers_start = Instant::now();
         let outputs = FrameOutputs {
             layers: Layers::of_frame(&scene, integrator.as_ref(), &pool, &aovs, plan.samples.clone()),
             ..outputs
         };
+        if !aovs.is_empty() {
+            timing.layers += layers_start.elapsed();
+        }
         let frame_label = frame.map(|(k, n)| format!(" frame {k} of {n}")).unwrap_or_default();
         let label = format!("{}{frame_label}", desc.kind);
         let header = PartialHeader {
@@ -269,13 +275,15 @@ pub fn render(args: RenderArgs) -> Result<(), String> {
             tonemap: scene.settings().tonemap,
         };
         let summary = if plan.partial {
-            render_partial(&scene, integrator.as_ref(), &pool, &progress, &outputs.images[0], header, &label)?
+            let output = &outputs.images[0];
+            render_partial(&scene, integrator.as_ref(), &pool, &progress, output, header, &label, &mut timing)?
         } else if progressive {
             let state = State { path: state_path(&outputs.images[0]), header, resume: args.resume };
             let target = args.target_error;
-            render_progressive(&scene, integrator.as_ref(), &pool, &progress, &outputs, target, &state, &label)?
+            let run = (&pool, &progress, &mut timing);
+            render_progressive(&scene, integrator.as_ref(), run, &outputs, target, &state, &label)?
         } else {
-            render_once(&scene, integrator.as_ref(), &pool, &progress, &outputs, &label)?
+            render_once(&scene, integrator.as_ref(), &pool, &progress, &outputs, &label, &mut timing)?
         };
         if !args.quiet && plan.frames.is_none() && !summary.is_empty() {
             progress.println(&summary);
@@ -299,7 +307,7 @@ pub fn render(args: RenderArgs) -> Result<(), String> {
         } else {
             written.join(", ")
         };
-        eprintln!("rendered {what} in {:.2} s → {shown}", elapsed.as_secs_f64());
+        eprintln!("rendered {what} in {} → {shown}", timing.summary(elapsed));
     }
     Ok(())
 }
@@ -415,18 +423,20 @@ fn render_once(
     progress: &Progress,
     outputs: &FrameOutputs,
     label: &str,
+    timing: &mut Timing,
 ) -> Result<String, String> {
     let s = scene.settings();
     progress.set_message(format!("{label} {}×{} {} spp", s.width, s.height, s.spp));
     let inc = |n: u64| progress.inc(n);
     let observer = RenderObserver { progress: Some(&inc), cancel: None };
-    let image = pool.install(|| airlight::render(scene, integrator, &observer));
-    write_images(scene, &image, outputs, None)?;
+    let image = timing.image(|| pool.install(|| airlight::render(scene, integrator, &observer)));
+    timing.writing(|| write_images(scene, &image, outputs, None))?;
     Ok(String::new())
 }
 
 /// One part of a render (`header`'s samples of its rows), written as a
 /// partial EXR.
+#[allow(clippy::too_many_arguments)]
 fn render_partial(
     scene: &Scene,
     integrator: &dyn Integrator,
@@ -435,12 +445,16 @@ fn render_partial(
     output: &Path,
     header: PartialHeader,
     label: &str,
+    timing: &mut Timing,
 ) -> Result<String, String> {
     progress.set_message(format!("{label} samples {:?} of rows {:?}", header.samples, header.rows));
     let inc = |n: u64| progress.inc(n);
     let observer = RenderObserver { progress: Some(&inc), cancel: None };
-    let sums = pool.install(|| accumulate(scene, integrator, header.samples.clone(), header.rows.clone(), &observer));
-    Partial { header, sums }.write(output).map_err(|e| format!("cannot write `{}`: {e}", output.display()))?;
+    let (samples, rows) = (header.samples.clone(), header.rows.clone());
+    let sums = timing.image(|| pool.install(|| accumulate(scene, integrator, samples, rows, &observer)));
+    timing
+        .writing(|| Partial { header, sums }.write(output))
+        .map_err(|e| format!("cannot write `{}`: {e}", output.display()))?;
     Ok(String::new())
 }
 
@@ -491,12 +505,10 @@ fn resumed(scene: &Scene, state: &State, progress: &Progress) -> Result<Progress
 /// far (atomically, so stopping the render loses at most the pass under
 /// way), until spp or the error target; returns the samples reached and the
 /// estimated error. The samples-so-far file is removed once done.
-#[allow(clippy::too_many_arguments)]
 fn render_progressive(
     scene: &Scene,
     integrator: &dyn Integrator,
-    pool: &rayon::ThreadPool,
-    progress: &Progress,
+    (pool, progress, timing): (&rayon::ThreadPool, &Progress, &mut Timing),
     outputs: &FrameOutputs,
     target_error: Option<f64>,
     state: &State,
@@ -508,12 +520,12 @@ fn render_progressive(
     if progressive.samples() > 0 && (progressive.finished() || target_error.is_some_and(|target| error < target)) {
         // Stopped after its last pass, before it tidied up: the images again.
         let variance = outputs.layers.wants_variance().then(|| progressive.variance());
-        write_images(scene, &progressive.image(), outputs, variance.as_ref())?;
+        timing.writing(|| write_images(scene, &progressive.image(), outputs, variance.as_ref()))?;
     }
     while !progressive.finished() && !target_error.is_some_and(|target| error < target) {
         let inc = |n: u64| progress.inc(n);
         let observer = RenderObserver { progress: Some(&inc), cancel: None };
-        pool.install(|| progressive.pass(scene, integrator, &observer));
+        timing.image(|| pool.install(|| progressive.pass(scene, integrator, &observer)));
         error = progressive.estimated_relative_error();
         progress.set_message(format!(
             "{label} {}×{} {}/{} spp, est. error {}",
@@ -523,17 +535,19 @@ fn render_progressive(
             s.spp,
             format_error(error),
         ));
-        let variance = outputs.layers.wants_variance().then(|| progressive.variance());
-        write_images(scene, &progressive.image(), outputs, variance.as_ref())?;
-        // The variance is known from the second sample on (EXR: linear, the
-        // tone map is not applied).
-        if let Some(path) = outputs.variance.as_ref().filter(|_| progressive.samples() >= 2) {
-            progressive.variance().save(path).map_err(|e| format!("cannot write `{}`: {e}", path.display()))?;
-        }
-        let header = PartialHeader { samples: 0..progressive.samples() as u64, ..state.header.clone() };
-        Partial { header, sums: progressive.accumulator().clone() }
-            .write(&state.path)
-            .map_err(|e| format!("cannot write `{}`: {e}", state.path.display()))?;
+        timing.writing(|| {
+            let variance = outputs.layers.wants_variance().then(|| progressive.variance());
+            write_images(scene, &progressive.image(), outputs, variance.as_ref())?;
+            // The variance is known from the second sample on (EXR: linear,
+            // the tone map is not applied).
+            if let Some(path) = outputs.variance.as_ref().filter(|_| progressive.samples() >= 2) {
+                progressive.variance().save(path).map_err(|e| format!("cannot write `{}`: {e}", path.display()))?;
+            }
+            let header = PartialHeader { samples: 0..progressive.samples() as u64, ..state.header.clone() };
+            Partial { header, sums: progressive.accumulator().clone() }
+                .write(&state.path)
+                .map_err(|e| format!("cannot write `{}`: {e}", state.path.display()))
+        })?;
     }
     let _ = std::fs::remove_file(&state.path);
     // Samples skipped by reaching the target still count toward the bar.

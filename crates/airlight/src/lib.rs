@@ -48,7 +48,7 @@ pub mod texture;
 /// Linear RGB radiance, irradiance or reflectance.
 pub type Rgb = glam::Vec3;
 
-pub use camera::Camera;
+pub use camera::{Camera, CameraRays};
 pub use film::Image;
 pub use render::{RenderObserver, render};
 pub use scene::{Scene, SceneBuilder};

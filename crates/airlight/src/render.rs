@@ -4,6 +4,7 @@
 //! samples were grouped (one render, progressive passes, shards).
 
 use crate::Rgb;
+use crate::camera::CameraRays;
 use crate::film::{Accumulator, Image, PixelSum};
 use crate::integrator::{Integrator, IntegratorError};
 use crate::sampling::Sampler;
@@ -91,53 +92,51 @@ pub fn accumulate(
     let (w, h) = (s.width, s.height);
     let mut acc = Accumulator::band(w, h, rows);
     let rows = acc.rows();
-    let tiles_x = w.div_ceil(TILE);
-    let bands = (rows.end - rows.start).div_ceil(TILE);
-    let tiles: Vec<(u32, u32)> = (0..bands).flat_map(|ty| (0..tiles_x).map(move |tx| (tx, ty))).collect();
-    let per_pixel = samples.end.saturating_sub(samples.start);
-    let rendered: Vec<Vec<PixelSum>> = tiles
-        .par_iter()
-        .map(|&(tx, ty)| {
-            let (x0, y0) = (tx * TILE, rows.start + ty * TILE);
-            let (x1, y1) = ((x0 + TILE).min(w), (y0 + TILE).min(rows.end));
-            if observer.cancelled() {
-                return vec![PixelSum::default(); ((x1 - x0) * (y1 - y0)) as usize];
-            }
-            let out = tile_sums(scene, integrator, (x0, y0), (x1, y1), samples.clone());
-            if let Some(progress) = observer.progress {
-                progress(out.len() as u64 * per_pixel);
-            }
-            out
-        })
-        .collect();
-    for (&(tx, ty), tile) in tiles.iter().zip(&rendered) {
-        let (x0, y0) = (tx * TILE, rows.start + ty * TILE);
-        let tile_w = (x0 + TILE).min(w) - x0;
-        for (i, sum) in tile.iter().enumerate() {
-            let (x, y) = (x0 + i as u32 % tile_w, y0 + i as u32 / tile_w);
-            if let Some(p) = acc.pixel_mut(x, y) {
-                *p = *sum;
+    // Each tile gets its rows of the accumulator's pixels (disjoint slices)
+    // and adds its samples there: no copy, no second image-sized buffer.
+    let mut tiles: Vec<((u32, u32), TileRows)> = Vec::new();
+    // (`max(1)`: an image 0 pixels wide has no pixels and no tiles.)
+    for (ty, band) in acc.pixels_mut().chunks_mut((TILE * w).max(1) as usize).enumerate() {
+        let mut band_tiles: Vec<TileRows> = (0..w.div_ceil(TILE)).map(|_| Vec::new()).collect();
+        for row in band.chunks_mut(w.max(1) as usize) {
+            for (tile, part) in band_tiles.iter_mut().zip(row.chunks_mut(TILE as usize)) {
+                tile.push(part);
             }
         }
+        let origin = |tx: usize| (tx as u32 * TILE, rows.start + ty as u32 * TILE);
+        tiles.extend(band_tiles.into_iter().enumerate().map(|(tx, tile)| (origin(tx), tile)));
     }
+    let per_pixel = samples.end.saturating_sub(samples.start);
+    tiles.into_par_iter().for_each(|(origin, mut tile)| {
+        if observer.cancelled() {
+            return;
+        }
+        tile_sums(scene, integrator, origin, &mut tile, samples.clone());
+        if let Some(progress) = observer.progress {
+            progress(tile.iter().map(|row| row.len() as u64).sum::<u64>() * per_pixel);
+        }
+    });
     acc
 }
 
-/// The summed samples `samples` of the pixels of the tile [x0, x1) × [y0,
-/// y1), row by row. The samples of each [`BLOCK`]×[`BLOCK`] block of pixels
-/// go to the integrator together, sample number by sample number, in
-/// [`BLOCK_ORDER`]; each pixel's sum is [`pixel_sum`]'s, bit for bit (the
-/// same samples, added in the same order).
+/// A tile's rows of the accumulator's pixel sums, top row first.
+type TileRows<'a> = Vec<&'a mut [PixelSum]>;
+
+/// Adds the samples `samples` of the pixels of the tile whose top-left
+/// pixel is (x0, y0) into `tile`, its rows of pixel sums. The samples of
+/// each [`BLOCK`]×[`BLOCK`] block of pixels go to the integrator together,
+/// sample number by sample number, in [`BLOCK_ORDER`]; each pixel's sum is
+/// [`pixel_sum`]'s, bit for bit (the same samples, added in the same order).
 fn tile_sums(
     scene: &Scene,
     integrator: &dyn Integrator,
     (x0, y0): (u32, u32),
-    (x1, y1): (u32, u32),
+    tile: &mut [&mut [PixelSum]],
     samples: Range<u64>,
-) -> Vec<PixelSum> {
+) {
     let s = scene.settings();
-    let tile_w = x1 - x0;
-    let mut out = vec![PixelSum::default(); (tile_w * (y1 - y0)) as usize];
+    let (x1, y1) = (x0 + tile.first().map_or(0, |row| row.len() as u32), y0 + tile.len() as u32);
+    let film = scene.camera().rays(s.width, s.height);
     let n = BLOCK_ORDER.len();
     let (mut pixels, mut rays, mut samplers) = (Vec::with_capacity(n), Vec::with_capacity(n), Vec::with_capacity(n));
     let mut radiance = vec![Rgb::ZERO; n];
@@ -150,18 +149,17 @@ fn tile_sums(
                 samplers.clear();
                 for &(x, y) in &pixels {
                     let mut sampler = Sampler::for_pixel(s.seed, y as u64 * s.width as u64 + x as u64, i);
-                    rays.push(camera_ray(scene, integrator.stratified(), x, y, &mut sampler));
+                    rays.push(film_ray(&film, s.filter, integrator.stratified(), x, y, &mut sampler));
                     samplers.push(sampler);
                 }
                 let radiance = &mut radiance[..pixels.len()];
                 integrator.radiance_batch(scene, &rays, &mut samplers, radiance);
                 for (&(x, y), r) in pixels.iter().zip(radiance.iter()) {
-                    out[((y - y0) * tile_w + (x - x0)) as usize].add(*r);
+                    tile[(y - y0) as usize][(x - x0) as usize].add(*r);
                 }
             }
         }
     }
-    out
 }
 
 /// The samples `samples` of pixel (x, y), summed.
@@ -190,18 +188,30 @@ pub fn pixel_sum(scene: &Scene, integrator: &dyn Integrator, x: u32, y: u32, sam
 /// exactly the render's rays.
 pub fn camera_ray(scene: &Scene, stratified: bool, x: u32, y: u32, sampler: &mut Sampler) -> crate::geometry::Ray {
     let s = scene.settings();
+    film_ray(&scene.camera().rays(s.width, s.height), s.filter, stratified, x, y, sampler)
+}
+
+/// [`camera_ray`] with what the camera's rays share worked out once.
+fn film_ray(
+    film: &CameraRays,
+    filter: PixelFilter,
+    stratified: bool,
+    x: u32,
+    y: u32,
+    sampler: &mut Sampler,
+) -> crate::geometry::Ray {
     let (jitter, lens) = if stratified {
         let u = sampler.stratified4(0);
         (Vec2::new(u[0], u[1]), Vec2::new(u[2], u[3]))
     } else {
         (sampler.next2(), sampler.next2())
     };
-    let film = Vec2::new(x as f32, y as f32)
-        + match s.filter {
+    let point = Vec2::new(x as f32, y as f32)
+        + match filter {
             PixelFilter::Box => jitter,
             PixelFilter::Point => Vec2::splat(0.5),
         };
-    scene.camera().ray(film, s.width, s.height, lens)
+    film.ray(point, lens)
 }
 
 /// Moves `scene` to `time` in [0, 1] of its light animation and tells

@@ -7,7 +7,7 @@
 use glam::{Affine3A, Mat3, Vec2, Vec3};
 
 /// A shape of the scene, in world space once built.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, PartialEq)]
 pub enum Shape {
     Sphere {
         center: Vec3,
@@ -46,6 +46,53 @@ pub enum Shape {
         shape: std::boxed::Box<Shape>,
         world_from_local: Affine3A,
     },
+}
+
+/// A mesh's data in its debug text (and so in a render's fingerprint,
+/// `airlight::fingerprint`) as counts and a checksum of the bit patterns:
+/// exact like the numbers themselves, without formatting millions of them.
+impl std::fmt::Debug for Shape {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Shape::Sphere { center, radius } => {
+                f.debug_struct("Sphere").field("center", center).field("radius", radius).finish()
+            }
+            Shape::Plane { point, normal } => {
+                f.debug_struct("Plane").field("point", point).field("normal", normal).finish()
+            }
+            Shape::Quad { corner, edge_u, edge_v } => {
+                f.debug_struct("Quad").field("corner", corner).field("edge_u", edge_u).field("edge_v", edge_v).finish()
+            }
+            Shape::Box { min, max } => f.debug_struct("Box").field("min", min).field("max", max).finish(),
+            Shape::Mesh { positions, triangles, uvs } => {
+                let words = positions.iter().flat_map(|p| p.to_array().map(f32::to_bits));
+                let words = words.chain(triangles.iter().flatten().copied());
+                let words = words.chain(uvs.iter().flat_map(|uv| uv.to_array().map(f32::to_bits)));
+                f.debug_struct("Mesh")
+                    .field("positions", &positions.len())
+                    .field("triangles", &triangles.len())
+                    .field("uvs", &uvs.len())
+                    .field("checksum", &format_args!("{:016x}", checksum(words)))
+                    .finish()
+            }
+            Shape::Sdf(sdf) => f.debug_tuple("Sdf").field(sdf).finish(),
+            Shape::Transformed { shape, world_from_local } => {
+                f.debug_struct("Transformed").field("shape", shape).field("world_from_local", world_from_local).finish()
+            }
+        }
+    }
+}
+
+/// FNV-1a (Fowler, Noll and Vo) over 32-bit words, a word at a time: the
+/// same on every machine. Four interleaved streams combined at the end, so
+/// that the multiplications of one do not wait for the others'.
+fn checksum(words: impl Iterator<Item = u32>) -> u64 {
+    const PRIME: u64 = 0x0000_0100_0000_01b3;
+    let mut h = [0, 1, 2, 3].map(|i| 0xcbf2_9ce4_8422_2325u64 ^ i);
+    for (i, w) in words.enumerate() {
+        h[i % 4] = (h[i % 4] ^ w as u64).wrapping_mul(PRIME);
+    }
+    h[1..].iter().fold(h[0], |acc, &x| (acc ^ x).wrapping_mul(PRIME))
 }
 
 impl Shape {

@@ -1,7 +1,7 @@
 use super::*;
 use crate::prelude::*;
 use crate::render::{RenderObserver, render};
-use glam::Affine3A;
+use glam::{Affine3A, Vec2};
 
 const SCENE: &str = r#"
 [render]
@@ -97,5 +97,44 @@ fn the_fingerprint_follows_every_value_that_changes_the_image() {
     steps.integrator.raymarch.steps += 1;
     for (what, other) in [("spp", spp), ("a light", light), ("an option", steps)] {
         assert_ne!(print(&a), print(&other), "{what} changed");
+    }
+}
+
+#[test]
+fn the_fingerprint_follows_every_number_of_a_mesh() {
+    // A mesh's numbers enter the fingerprint as a checksum of their bits
+    // (not as formatted text): each change below, down to the sign of a
+    // zero, must change it.
+    let positions = vec![vec3(0.0, 0.0, 0.0), vec3(1.0, 0.0, 0.0), vec3(0.0, 1.0, 0.0), vec3(1.0, 1.0, 0.0)];
+    let mesh = |positions: Vec<Vec3>, triangles: Vec<[u32; 3]>, uvs: Vec<Vec2>| {
+        let scene = SceneBuilder::new()
+            .material("grey", Material::diffuse(Rgb::splat(0.5)))
+            .object(Shape::Mesh { positions, triangles, uvs }, "grey")
+            .build()
+            .unwrap();
+        super::fingerprint(&scene, &IntegratorDesc::default())
+    };
+    let triangles = vec![[0, 1, 2], [1, 3, 2]];
+    let a = mesh(positions.clone(), triangles.clone(), Vec::new());
+    assert_eq!(a, mesh(positions.clone(), triangles.clone(), Vec::new()), "the same mesh, the same fingerprint");
+    let mut signed_zero = positions.clone();
+    signed_zero[0].z = -0.0;
+    let mut nudged = positions.clone();
+    nudged[3].y = f32::from_bits(1.0f32.to_bits() + 1);
+    let swapped = vec![[1, 3, 2], [0, 1, 2]];
+    let uvs = |v: f32| vec![Vec2::ZERO, Vec2::X, Vec2::Y, Vec2::new(1.0, v)];
+    // Each print differs from every other one.
+    let prints = [
+        ("the mesh", a),
+        ("a zero's sign", mesh(signed_zero, triangles.clone(), Vec::new())),
+        ("a position by one ulp", mesh(nudged, triangles.clone(), Vec::new())),
+        ("the triangles' order", mesh(positions.clone(), swapped, Vec::new())),
+        ("texture coordinates added", mesh(positions.clone(), triangles.clone(), uvs(1.0))),
+        ("a texture coordinate", mesh(positions.clone(), triangles.clone(), uvs(0.5))),
+    ];
+    for (i, (what, print)) in prints.iter().enumerate() {
+        for (other, other_print) in &prints[..i] {
+            assert_ne!(print, other_print, "{what} against {other}");
+        }
     }
 }
