@@ -232,11 +232,16 @@ mod tests {
     #[test]
     fn a_first_pass_that_fits_runs() {
         // 1 ms samples: a pass of 1 spp takes about 0.5 s on two threads,
-        // which fits in 0.8 s (on one thread it would not); the second
-        // would not fit in the share.
+        // and the passes of 1, 1, 2 and 4 spp end at about 0.5, 1, 2 and
+        // 4 s: the first fits in 2 s even if a loaded machine makes every
+        // sleep three times as long, and the run stops because a later
+        // pass would not fit. How many passes fit depends on the load, so
+        // only their being at least one is asserted, and that the run ends
+        // near its share, not a pass late.
         let slow = Slow { per_sample: Duration::from_millis(1) };
-        let (stop, rungs, took) = run_with(&slow, 0.8);
-        assert_eq!((stop, rungs), (Stop::Share, 1));
-        assert!(took < Duration::from_millis(1500), "{took:?}");
+        let (stop, rungs, took) = run_with(&slow, 2.0);
+        assert_eq!(stop, Stop::Share);
+        assert!((1..=3).contains(&rungs), "{rungs} passes");
+        assert!(took < Duration::from_millis(3000), "{took:?}");
     }
 }
