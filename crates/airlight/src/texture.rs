@@ -83,11 +83,19 @@ impl std::fmt::Debug for Texture {
             .field("height", &self.height)
             .field("wrap", &(self.wrap_u, self.wrap_v))
             .field("mean", &self.mean)
+            // The texels themselves, so that the debug text (a render's
+            // fingerprint) changes with any of them, not only with the mean.
+            .field("checksum", &format_args!("{:016x}", self.checksum()))
             .finish()
     }
 }
 
 impl Texture {
+    /// A hash of the texels' bytes, three to a word.
+    fn checksum(&self) -> u64 {
+        crate::geometry::checksum(self.texels.iter().map(|&[r, g, b]| u32::from_le_bytes([r, g, b, 0])))
+    }
+
     /// A texture of `width × height` sRGB texels, row by row from the top;
     /// None if the sizes do not match or one is zero.
     pub fn from_srgb8(width: u32, height: u32, texels: Vec<[u8; 3]>) -> Option<Texture> {
@@ -189,6 +197,15 @@ mod tests {
     /// A 2×2 texture: red, green / blue, white (sRGB 255 and 0: linear 1 and 0).
     fn two_by_two() -> Texture {
         Texture::from_srgb8(2, 2, vec![[255, 0, 0], [0, 255, 0], [0, 0, 255], [255, 255, 255]]).unwrap()
+    }
+
+    #[test]
+    fn the_debug_text_changes_with_the_texels_not_only_their_mean() {
+        // The same mean colour, the texels swapped: a different image.
+        let swapped = Texture::from_srgb8(2, 2, vec![[0, 255, 0], [255, 0, 0], [0, 0, 255], [255, 255, 255]]).unwrap();
+        assert_eq!(swapped.mean(), two_by_two().mean());
+        assert_ne!(format!("{swapped:?}"), format!("{:?}", two_by_two()));
+        assert_eq!(format!("{:?}", two_by_two()), format!("{:?}", two_by_two()));
     }
 
     #[test]

@@ -12,4 +12,5 @@ pub use accel::{Geometry, GeometryBuilder, Hit, SurfaceHit, shadow_rays_traced};
 pub use batch::Segment;
 pub use ray::{Ray, offset_origin};
 pub use sdf::Sdf;
+pub(crate) use shape::checksum;
 pub use shape::{Shape, intersect_box, intersect_quad, intersect_sphere, intersect_triangle};

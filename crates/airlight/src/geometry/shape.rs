@@ -86,7 +86,7 @@ impl std::fmt::Debug for Shape {
 /// FNV-1a (Fowler, Noll and Vo) over 32-bit words, a word at a time: the
 /// same on every machine. Four interleaved streams combined at the end, so
 /// that the multiplications of one do not wait for the others'.
-fn checksum(words: impl Iterator<Item = u32>) -> u64 {
+pub(crate) fn checksum(words: impl Iterator<Item = u32>) -> u64 {
     const PRIME: u64 = 0x0000_0100_0000_01b3;
     let mut h = [0, 1, 2, 3].map(|i| 0xcbf2_9ce4_8422_2325u64 ^ i);
     for (i, w) in words.enumerate() {
