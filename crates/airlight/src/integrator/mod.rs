@@ -14,7 +14,7 @@ mod raymarch;
 mod stochastic;
 
 pub use analytic::{Analytic, AnalyticOptions};
-pub use batch::{ShadowScratch, first_surface_batch, surface_radiance_batch};
+pub use batch::first_surface_batch;
 pub use direct::Direct;
 pub use equiangular::Equiangular;
 pub use options::{
@@ -241,7 +241,7 @@ pub fn no_extra(_: &SurfaceHit) -> Rgb {
 /// Radiance leaving a surface toward `-ray.dir`: its emission plus direct
 /// light from every light, one sample per area light, with shadow rays. In a
 /// medium, light arriving from each light is attenuated on its way.
-/// (`batch.rs` computes the same for many rays at once:
+/// (`batch.rs` computes the same without a medium for many rays at once:
 /// a change here must be made there too; the render tests compare them.)
 pub fn surface_radiance(
     scene: &Scene,
