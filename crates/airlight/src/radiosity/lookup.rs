@@ -58,27 +58,11 @@ struct Near {
     /// The grid's first cell and its size in cells.
     lo: IVec3,
     size: IVec3,
-    /// Cell k's list is `ids[starts[k]..starts[k] + lens[k]]`, cells in
-    /// x-major order; each list starts at a multiple of [`LANES`] (padded).
+    /// Cell k's list is `ids[starts[k]..starts[k + 1]]`, cells in x-major order.
     starts: Vec<u32>,
-    lens: Vec<u32>,
     ids: Vec<u32>,
-    /// The lists' centres and normals in list order, [`LANES`] entries a
-    /// block: a query reads them straight into its lanes instead of
-    /// gathering them by patch id.
-    blocks: Vec<Block>,
-}
-
-/// Candidates tested at a time (see [`Lookup::weights`]).
-const LANES: usize = 8;
-
-/// Centres and normals of [`LANES`] consecutive list entries, by coordinate
-/// (three 64-byte lines).
-#[derive(Clone, Copy, Debug, Default)]
-#[repr(C, align(64))]
-struct Block {
-    center: [[f32; LANES]; 3],
-    normal: [[f32; LANES]; 3],
+    /// Centre and normal of every patch, packed for the lists' gathers.
+    points: Vec<(Vec3, Vec3)>,
 }
 
 impl Near {
@@ -125,49 +109,37 @@ impl Near {
             }
         }
         keyed.par_sort_unstable();
-        let cells = size.element_product() as usize;
-        let (mut starts, mut lens) = (vec![0u32; cells], vec![0u32; cells]);
+        let mut starts = vec![0u32; size.element_product() as usize + 1];
         for &(k, _) in &keyed {
-            lens[k as usize] += 1;
+            starts[k as usize + 1] += 1;
         }
-        let mut padded = 0usize;
-        for (start, &len) in starts.iter_mut().zip(&lens) {
-            *start = padded as u32;
-            padded += (len as usize).div_ceil(LANES) * LANES;
+        for k in 1..starts.len() {
+            starts[k] += starts[k - 1];
         }
-        let (mut list_ids, mut blocks) = (vec![0u32; padded], vec![Block::default(); padded / LANES]);
-        let mut next = starts.clone();
-        for &(k, rank) in &keyed {
-            let at = next[k as usize] as usize;
-            next[k as usize] += 1;
-            let i = ids[rank as usize];
-            let (c, n) = (patches[i as usize].center, patches[i as usize].normal);
-            let (block, lane) = (&mut blocks[at / LANES], at % LANES);
-            (block.center[0][lane], block.center[1][lane], block.center[2][lane]) = (c.x, c.y, c.z);
-            (block.normal[0][lane], block.normal[1][lane], block.normal[2][lane]) = (n.x, n.y, n.z);
-            list_ids[at] = i;
-        }
-        Some(Near { cell, lo, size, starts, lens, ids: list_ids, blocks })
+        Some(Near {
+            cell,
+            lo,
+            size,
+            starts,
+            ids: keyed.into_iter().map(|(_, rank)| ids[rank as usize]).collect(),
+            points: patches.iter().map(|p| (p.center, p.normal)).collect(),
+        })
     }
 
-    /// The list of the cell that holds `p` (empty outside the grid): its
-    /// patch ids, padded to whole blocks, their blocks, and its length.
+    /// The list of the cell that holds `p` (empty outside the grid).
     #[inline]
-    fn list(&self, p: Vec3) -> (&[u32], &[Block], usize) {
+    fn list(&self, p: Vec3) -> &[u32] {
         // In i64: a far point's cell saturates i32.
         let (k, size) = ((p / self.cell).floor().as_i64vec3() - self.lo.as_i64vec3(), self.size.as_i64vec3());
         if k.cmplt(I64Vec3::ZERO).any() || k.cmpge(size).any() {
-            return (&[], &[], 0);
+            return &[];
         }
         let k = ((k.x * size.y + k.y) * size.z + k.z) as usize;
-        let (start, len) = (self.starts[k] as usize, self.lens[k] as usize);
-        let end = start + len.div_ceil(LANES) * LANES;
-        (&self.ids[start..end], &self.blocks[start / LANES..end / LANES], len)
+        &self.ids[self.starts[k] as usize..self.starts[k + 1] as usize]
     }
 
     fn bytes(&self) -> usize {
-        (self.ids.capacity() + self.starts.capacity() + self.lens.capacity()) * 4
-            + self.blocks.capacity() * size_of::<Block>()
+        (self.ids.capacity() + self.starts.capacity()) * 4 + self.points.capacity() * size_of::<(Vec3, Vec3)>()
     }
 }
 
@@ -260,24 +232,26 @@ impl Lookup {
         let r = self.radius;
         let mut weight = 0.0;
         if let Some(near) = near {
-            // Eight candidates at a time, read straight from the list's
-            // blocks, their tests and weights computed without branches (so
-            // the compiler can use vector lanes), then their terms taken in
-            // order: the arithmetic of `take` below, operation for
-            // operation, so the same bits. The padding lanes of a list's
-            // last block are never taken.
-            let (ids, blocks, len) = near.list(p);
-            for (j, (chunk, block)) in ids.chunks_exact(LANES).zip(blocks).enumerate() {
-                let valid = len - j * LANES;
+            // Eight candidates at a time, their tests and weights computed
+            // without branches (so the compiler can use vector lanes), then
+            // their terms taken in order: the arithmetic of `take` below,
+            // operation for operation, so the same bits.
+            const LANES: usize = 8;
+            for chunk in near.list(p).chunks(LANES) {
+                let (mut c, mut m) = ([[0.0f32; LANES]; 3], [[0.0f32; LANES]; 3]);
+                for (k, &i) in chunk.iter().enumerate() {
+                    let (center, normal) = near.points[i as usize];
+                    (c[0][k], c[1][k], c[2][k]) = (center.x, center.y, center.z);
+                    (m[0][k], m[1][k], m[2][k]) = (normal.x, normal.y, normal.z);
+                }
                 let (mut w, mut ok) = ([0.0f32; LANES], [false; LANES]);
                 for k in 0..LANES {
-                    let (c, m) = (&block.center, &block.normal);
                     let d = Vec3::new(c[0][k], c[1][k], c[2][k]) - p;
                     let facing = 2.0 * n.dot(Vec3::new(m[0][k], m[1][k], m[2][k])) - 1.0;
                     let dist = d.length();
                     // `take`'s rejections, NaNs included.
                     let reject = (facing <= 0.0) | (n.dot(d).abs() > 0.5 * r) | (dist >= r);
-                    ok[k] = !reject & (k < valid);
+                    ok[k] = !reject;
                     w[k] = (1.0 - dist / r) * facing;
                 }
                 for (k, &i) in chunk.iter().enumerate() {
