@@ -7,6 +7,10 @@
 //! Area lights are surfaces the camera can see, and they move: the cache
 //! holds hits against the scene's objects only, and each frame tests the
 //! camera rays against the lights' surfaces where they are now.
+//!
+//! A new view (a moving camera: every frame) fills each pixel's texel and
+//! shades it in the same step, with one generator, while the texel and its
+//! weights are still in cache; the texels stay for the frames after.
 
 use super::Preview;
 use crate::Rgb;
