@@ -7,12 +7,9 @@
 //! Area lights are surfaces the camera can see, and they move: the cache
 //! holds hits against the scene's objects only, and each frame tests the
 //! camera rays against the lights' surfaces where they are now.
-//!
-//! A new view (a moving camera: every frame) fills each pixel's texel and
-//! shades it in the same step, with one generator, while the texel and its
-//! weights are still in cache; the texels stay for the frames after.
 
 use super::Preview;
+use crate::Camera;
 use crate::Rgb;
 use crate::film::Image;
 use crate::geometry::{Geometry, GeometryBuilder, Ray, SurfaceHit};
@@ -20,7 +17,6 @@ use crate::integrator::{surface_radiance, through_medium};
 use crate::radiosity::Radiosity;
 use crate::sampling::Sampler;
 use crate::scene::{PixelFilter, Scene};
-use crate::{Camera, CameraRays};
 use glam::Vec2;
 use rayon::prelude::*;
 use std::f32::consts::FRAC_1_PI;
@@ -73,122 +69,107 @@ impl FirstSample {
     /// cache, which is refilled first when the camera, image size, seed or
     /// filter changed.
     pub fn render(&mut self, scene: &Scene, solution: Option<&Radiosity>, preview: &Preview) -> Image {
-        let lights = light_surfaces(scene);
-        let (w, h) = (scene.settings().width as usize, scene.settings().height as usize);
-        let mut image = Image::new(w as u32, h as u32);
-        let shading = Shading { scene, solution, preview, lights: &lights };
-        if self.is_valid_for(scene) {
-            let (texels, weights) = (&self.texels, &self.weights);
-            image.pixels.par_chunks_mut(w.max(1)).enumerate().for_each(|(y, row)| {
-                for (x, out) in row.iter_mut().enumerate() {
-                    let index = y * w + x;
-                    let mut sampler = first_sampler(scene, index as u64);
-                    // The camera's draws, made by the renderer before the integrator's.
-                    sampler.next2();
-                    sampler.next2();
-                    *out = shading.shade(&texels[index], &weights[y], &mut sampler);
-                }
-            });
-            return image;
+        if !self.is_valid_for(scene) {
+            self.fill(scene, solution);
         }
-        // A new view: each pixel's texel is filled and shaded in one go,
-        // while it and its weights are in cache, with one sampler.
+        let lights = light_surfaces(scene);
+        let (w, h) = (scene.settings().width, scene.settings().height);
+        let mut image = Image::new(w, h);
+        image.pixels.par_chunks_mut(w.max(1) as usize).enumerate().for_each(|(y, row)| {
+            for (x, out) in row.iter_mut().enumerate() {
+                *out = self.shade(scene, solution, preview, &lights, y, y * w as usize + x);
+            }
+        });
+        image
+    }
+
+    fn fill(&mut self, scene: &Scene, solution: Option<&Radiosity>) {
+        let s = scene.settings();
+        let (w, h) = (s.width as usize, s.height as usize);
         if self.texels.len() != w * h {
             let ray = Ray::new(glam::Vec3::ZERO, glam::Vec3::Z);
             let empty = Texel { ray, hit: None, t: 0.0, albedo: Rgb::ZERO, start: 0, len: 0, scale: 0.0 };
             self.texels = vec![empty; w * h];
         }
         self.weights.resize_with(h, Vec::new);
-        let (objects, film) = (&self.objects, scene.camera().rays(w as u32, h as u32));
-        let rows = self.texels.par_chunks_mut(w.max(1)).zip(self.weights.par_iter_mut());
-        image.pixels.par_chunks_mut(w.max(1)).zip(rows).enumerate().for_each(|(y, (row, (texels, weights)))| {
-            weights.clear();
-            for (x, (out, texel)) in row.iter_mut().zip(texels).enumerate() {
-                let mut sampler = first_sampler(scene, (y * w + x) as u64);
-                *texel = fill(scene, solution, objects, &film, x, y, &mut sampler, weights);
-                *out = shading.shade(texel, weights, &mut sampler);
-            }
-        });
+        let objects = &self.objects;
+        self.texels.par_chunks_mut(w.max(1)).zip(self.weights.par_iter_mut()).enumerate().for_each(
+            |(y, (texels, weights))| {
+                weights.clear();
+                for (x, texel) in texels.iter_mut().enumerate() {
+                    let mut sampler = first_sampler(scene, (y * w + x) as u64);
+                    let (jitter, lens) = (sampler.next2(), sampler.next2());
+                    let film = Vec2::new(x as f32, y as f32)
+                        + match s.filter {
+                            PixelFilter::Box => jitter,
+                            PixelFilter::Point => Vec2::splat(0.5),
+                        };
+                    let ray = scene.camera().ray(film, s.width, s.height, lens);
+                    let t = f32::INFINITY;
+                    *texel = Texel { ray, hit: None, t, albedo: Rgb::ZERO, start: 0, len: 0, scale: 0.0 };
+                    if let Some(hit) = objects.intersect(&ray, t) {
+                        let surface = objects.surface(&ray, hit);
+                        texel.hit = Some(surface);
+                        texel.t = hit.t;
+                        texel.albedo = scene.material_at(&surface).albedo(surface.p, surface.n) * FRAC_1_PI;
+                        if let Some(solution) = solution {
+                            let n = if surface.n.dot(ray.dir) <= 0.0 { surface.n } else { -surface.n };
+                            texel.start = weights.len() as u32;
+                            let lookup = solution.lookup();
+                            if let Some(scale) = lookup.weights(solution.patches(), surface.p, n, weights) {
+                                texel.len = weights.len() as u32 - texel.start;
+                                texel.scale = scale;
+                            }
+                        }
+                    }
+                }
+            },
+        );
         self.key = Some(key(scene));
-        image
     }
-}
 
-/// Pixel (x, y)'s texel, its lookup weights appended to `weights`; the
-/// camera's draws taken from `sampler`, as the renderer takes them.
-#[allow(clippy::too_many_arguments)]
-#[inline]
-fn fill(
-    scene: &Scene,
-    solution: Option<&Radiosity>,
-    objects: &Geometry,
-    film: &CameraRays,
-    x: usize,
-    y: usize,
-    sampler: &mut Sampler,
-    weights: &mut Vec<(u32, f32)>,
-) -> Texel {
-    let (jitter, lens) = (sampler.next2(), sampler.next2());
-    let point = Vec2::new(x as f32, y as f32)
-        + match scene.settings().filter {
-            PixelFilter::Box => jitter,
-            PixelFilter::Point => Vec2::splat(0.5),
-        };
-    let ray = film.ray(point, lens);
-    let t = f32::INFINITY;
-    let mut texel = Texel { ray, hit: None, t, albedo: Rgb::ZERO, start: 0, len: 0, scale: 0.0 };
-    if let Some(hit) = objects.intersect(&ray, t) {
-        let surface = objects.surface(&ray, hit);
-        texel.hit = Some(surface);
-        texel.t = hit.t;
-        texel.albedo = scene.material_at(&surface).albedo(surface.p, surface.n) * FRAC_1_PI;
-        if let Some(solution) = solution {
-            let n = if surface.n.dot(ray.dir) <= 0.0 { surface.n } else { -surface.n };
-            texel.start = weights.len() as u32;
-            if let Some(scale) = solution.lookup().weights(solution.patches(), surface.p, n, weights) {
-                texel.len = weights.len() as u32 - texel.start;
-                texel.scale = scale;
-            }
-        }
-    }
-    texel
-}
-
-/// What one frame shades with.
-struct Shading<'a> {
-    scene: &'a Scene,
-    solution: Option<&'a Radiosity>,
-    preview: &'a Preview<'a>,
-    /// The lights' surfaces where they are now.
-    lights: &'a Geometry,
-}
-
-impl Shading<'_> {
-    /// What `preview.radiance` gives for the texel's sample 0, `sampler`
-    /// past the camera's draws; `weights` is the texel's row's.
-    #[inline]
-    fn shade(&self, texel: &Texel, weights: &[(u32, f32)], sampler: &mut Sampler) -> Rgb {
-        let (scene, ray) = (self.scene, &texel.ray);
+    /// What `preview.radiance` gives for pixel `index`'s sample 0.
+    fn shade(
+        &self,
+        scene: &Scene,
+        solution: Option<&Radiosity>,
+        preview: &Preview,
+        lights: &Geometry,
+        row: usize,
+        index: usize,
+    ) -> Rgb {
+        let texel = &self.texels[index];
+        let ray = &texel.ray;
+        let mut sampler = first_sampler(scene, index as u64);
+        // The camera's draws, made by the renderer before the integrator's.
+        sampler.next2();
+        sampler.next2();
         let medium = scene.medium();
-        let (surface, t_end) = match self.lights.intersect(ray, texel.t) {
+        let (surface, t_end) = match lights.intersect(ray, texel.t) {
             // A light's surface in front of the objects (it reflects nothing).
-            Some(hit) => (surface_radiance(scene, ray, &self.lights.surface(ray, hit), sampler, medium), hit.t),
+            Some(hit) => (surface_radiance(scene, ray, &lights.surface(ray, hit), &mut sampler, medium), hit.t),
             None => match &texel.hit {
                 Some(s) => {
-                    let mut l = surface_radiance(scene, ray, s, sampler, medium);
-                    if let (Some(solution), true) = (self.solution, texel.len > 0) {
-                        let e = solution.indirect_irradiance();
-                        let ws = &weights[texel.start as usize..(texel.start + texel.len) as usize];
-                        let sum = ws.iter().fold(Rgb::ZERO, |sum, &(i, w)| sum + e[i as usize] * w);
-                        l += texel.albedo * (sum * texel.scale);
+                    let mut l = surface_radiance(scene, ray, s, &mut sampler, medium);
+                    if let Some(solution) = solution {
+                        let e = if texel.len > 0 {
+                            let e = solution.indirect_irradiance();
+                            let ws = &self.weights[row][texel.start as usize..(texel.start + texel.len) as usize];
+                            Some(ws.iter().fold(Rgb::ZERO, |sum, &(i, w)| sum + e[i as usize] * w) * texel.scale)
+                        } else {
+                            None
+                        };
+                        if let Some(e) = e {
+                            l += texel.albedo * e;
+                        }
                     }
                     (l, texel.t)
                 }
                 None => (scene.settings().background, scene.settings().max_distance),
             },
         };
-        let l = through_medium(scene, ray, surface, t_end, sampler, |medium, length, sampler| {
-            self.preview.glow(scene, medium, ray, length, sampler)
+        let l = through_medium(scene, ray, surface, t_end, &mut sampler, |medium, length, sampler| {
+            preview.glow(scene, medium, ray, length, sampler)
         });
         if l.is_finite() { l } else { Rgb::ZERO }
     }
