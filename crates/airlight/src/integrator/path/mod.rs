@@ -53,8 +53,7 @@ impl PathTracer {
     /// The numbers of scattering event `depth` (1 for the first) on a surface.
     fn bounce(&self, depth: u32, sampler: &mut Sampler) -> Bounce {
         if self.stratify {
-            let [l0, l1, d0, d1] = sampler.stratified4(depth);
-            Bounce { light: Some(Vec2::new(l0, l1)), direction: Vec2::new(d0, d1) }
+            Bounce { light: Some(sampler.stratified2(depth, 0)), direction: sampler.stratified2(depth, 1) }
         } else {
             Bounce { light: None, direction: sampler.next2() }
         }
