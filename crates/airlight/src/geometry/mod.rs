@@ -3,6 +3,7 @@
 mod accel;
 mod batch;
 mod bvh4;
+mod lanes;
 mod packet;
 mod ray;
 pub mod sdf;
