@@ -147,6 +147,6 @@ mod tests {
             assert_eq!(lanes.any_hit(o, d, tmax), want.iter().any(|t| t.is_finite()));
             hits += want.iter().filter(|t| t.is_finite()).count();
         }
-        assert!(hits > 10_000, "hits {hits}");
+        assert!(hits > 2000, "hits {hits}");
     }
 }
