@@ -46,19 +46,6 @@ impl Sampler {
         sobol::scrambled_sobol4(self.sample as u32, seed)
     }
 
-    /// Two stratified numbers in [0, 1): this sample's point of the pixel's
-    /// Owen-scrambled 2D Sobol' sequence number `slot` of `group`
-    /// ([`sobol::scrambled_sobol2`]). Each (group, slot) has its own
-    /// scramble and shuffle, so its pairs are independent of every other's
-    /// (Burley's padding), and any 2^k consecutive samples from 0 form a
-    /// (0, k, 2)-net: stratified in every 2D elementary interval, which
-    /// dimensions 2 and 3 of [`Sampler::stratified4`] are not.
-    pub fn stratified2(&self, group: u32, slot: u32) -> Vec2 {
-        let id = 2 * group as u64 + slot as u64 + 1;
-        let seed = (mix64(self.pixel_key ^ id.wrapping_mul(0xa076_1d64_78bd_642f)) >> 32) as u32;
-        Vec2::from(sobol::scrambled_sobol2(self.sample as u32, seed))
-    }
-
     /// A uniform number in [0, 1). (Not an Iterator: the stream never ends.)
     #[inline]
     #[allow(clippy::should_implement_trait)]

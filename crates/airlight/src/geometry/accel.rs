@@ -429,7 +429,7 @@ impl Geometry {
         let mut best = Hit { t: tmax, id: u32::MAX };
         if let Some((quads, others)) = &self.small {
             let (o, d) = (ray.origin, ray.dir);
-            quads.for_each_hit(o, d, tmax, |t, id| {
+            quads.for_each_nearest(o, d, tmax, |t, id| {
                 if comes_before(t, id, best.t, best.id) {
                     best = Hit { t, id };
                 }

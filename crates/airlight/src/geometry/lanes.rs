@@ -67,15 +67,20 @@ impl QuadLanes {
         QuadLanes { groups }
     }
 
-    /// Calls `found(t, id)` for every quad the ray `o + t·d` meets at
-    /// 0 < t < tmax.
+    /// Calls `found(t, id)`, group by group, for the nearest of the quads
+    /// the ray `o + t·d` meets at 0 < t < tmax (each at that distance, if
+    /// several are): the nearest hit and, of equal ones, any tie-break the
+    /// caller applies come out as from every hit.
     #[inline]
-    pub fn for_each_hit(&self, o: Vec3, d: Vec3, tmax: f32, mut found: impl FnMut(f32, u32)) {
+    pub fn for_each_nearest(&self, o: Vec3, d: Vec3, tmax: f32, mut found: impl FnMut(f32, u32)) {
         for g in &self.groups {
             let t = distances(g, o, d, tmax);
-            for k in 0..LANES {
-                if t[k] < tmax {
-                    found(t[k], g.id[k]);
+            let nearest = t.iter().fold(f32::INFINITY, |a, &b| a.min(b));
+            if nearest < tmax {
+                for (&t, &id) in t.iter().zip(&g.id) {
+                    if t == nearest {
+                        found(t, id);
+                    }
                 }
             }
         }
@@ -90,6 +95,9 @@ impl QuadLanes {
 
 /// Each lane's hit distance in (0, tmax), or infinity: `intersect_quad`'s
 /// operations lane by lane, without branches (a miss selects infinity).
+// One index across the group's many arrays, and `&` rather than `&&` and
+// range `contains`: straight-line code the compiler vectorises.
+#[allow(clippy::needless_range_loop, clippy::manual_range_contains)]
 #[inline(always)]
 fn distances(g: &Group, o: Vec3, d: Vec3, tmax: f32) -> [f32; LANES] {
     let mut out = [f32::INFINITY; LANES];
@@ -108,7 +116,8 @@ fn distances(g: &Group, o: Vec3, d: Vec3, tmax: f32) -> [f32; LANES] {
         let (bx, by, bz) = (uy * rz - ry * uz, uz * rx - rz * ux, ux * ry - rx * uy);
         let alpha = ((ax * nx) + (ay * ny) + (az * nz)) * g.inv_nn[k];
         let beta = ((bx * nx) + (by * ny) + (bz * nz)) * g.inv_nn[k];
-        let hit = !(denom.abs() < 1e-20)
+        // (A NaN denominator fails here, and its NaN t fails in the original.)
+        let hit = (denom.abs() >= 1e-20)
             & (t > 0.0)
             & (t < tmax)
             & (alpha >= 0.0)
@@ -140,10 +149,22 @@ mod tests {
             let o = (Vec3::new(s.next(), s.next(), s.next()) - 0.5) * 4.0;
             let d = uniform_sphere(s.next2());
             let tmax = if i % 2 == 0 { f32::INFINITY } else { 3.0 * s.next() };
-            let mut got = vec![f32::INFINITY; quads.len()];
-            lanes.for_each_hit(o, d, tmax, |t, id| got[id as usize] = t);
             let want: Vec<f32> = quads.iter().map(|&(_, c, u, w)| intersect_quad(c, u, w, o, d, 0.0, tmax)).collect();
-            assert_eq!(got, want, "ray {o} {d} {tmax}");
+            for g in &lanes.groups {
+                let got = distances(g, o, d, tmax);
+                for (k, &id) in g.id.iter().enumerate() {
+                    let want = want.get(id as usize).copied().unwrap_or(f32::INFINITY);
+                    assert_eq!(got[k].to_bits(), want.to_bits(), "ray {o} {d} {tmax} quad {id}");
+                }
+            }
+            // The nearest per group: no quad of the group nearer.
+            let mut nearest = Vec::new();
+            lanes.for_each_nearest(o, d, tmax, |t, id| nearest.push((t, id)));
+            for (t, id) in nearest {
+                assert_eq!(t, want[id as usize]);
+                let group = id as usize / LANES;
+                assert!(want[group * LANES..].iter().take(LANES).all(|&w| w >= t));
+            }
             assert_eq!(lanes.any_hit(o, d, tmax), want.iter().any(|t| t.is_finite()));
             hits += want.iter().filter(|t| t.is_finite()).count();
         }

@@ -157,25 +157,6 @@ pub fn scrambled_sobol4(index: u32, seed: u32) -> [f32; 4] {
     out
 }
 
-/// Point `index` of the shuffled, Owen-scrambled 2D Sobol' sequence with
-/// this seed: dimensions 0 and 1 of [`scrambled_sobol4`], the pair whose
-/// first 2^m points form a (0, m, 2)-net (every elementary interval of area
-/// 2^−m holds one point), at half the cost. Pairs drawn with independent
-/// seeds are Burley's padded 2D sequences.
-#[inline]
-pub fn scrambled_sobol2(index: u32, seed: u32) -> [f32; 2] {
-    let shuffled = owen_scramble(index, seed);
-    let mut second = 0;
-    for (j, row) in NIBBLES[0].iter().enumerate() {
-        second ^= row[((shuffled >> (4 * j)) & 15) as usize];
-    }
-    let coordinate = |reversed: u32, d: u32| {
-        let x = laine_karras(reversed, dimension_seed(seed, d)).reverse_bits();
-        (x >> 8) as f32 * (1.0 / (1u32 << 24) as f32)
-    };
-    [coordinate(shuffled, 0), coordinate(second, 1)]
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -253,16 +234,6 @@ mod tests {
                     })
                     .collect();
                 assert_eq!(scrambled_sobol4(index, seed).to_vec(), direct, "index {index} seed {seed}");
-            }
-        }
-    }
-
-    #[test]
-    fn two_dimensional_points_are_the_first_two_of_the_four() {
-        for seed in [0u32, 7, 0xdead_beef] {
-            for index in (0..4096u32).chain([u32::MAX, 0x8000_0000, 0x1234_5678]) {
-                let four = scrambled_sobol4(index, seed);
-                assert_eq!(scrambled_sobol2(index, seed), [four[0], four[1]], "index {index} seed {seed}");
             }
         }
     }
