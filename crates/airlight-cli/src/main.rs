@@ -16,6 +16,7 @@ mod outputs;
 mod plot;
 mod preflight;
 mod progress;
+mod progressive;
 mod render;
 mod study;
 mod submit;

@@ -7,6 +7,7 @@ use crate::aovs::Layers;
 use crate::load;
 use crate::preflight::Forecast;
 use crate::progress::Progress;
+use crate::progressive::{State, render_progressive, state_path};
 use crate::timing::Timing;
 use airlight::SceneFile;
 use airlight::aov::Aov;
@@ -14,7 +15,7 @@ use airlight::film::Image;
 use airlight::film::partial::{Partial, PartialHeader, piece};
 use airlight::integrator::analytic::LightQuadrature;
 use airlight::integrator::{Integrator, IntegratorKind, MAX_LIGHT_STEPS, MAX_STEPS, Sampling};
-use airlight::render::{Progressive, RenderObserver, accumulate, frame_time, set_time};
+use airlight::render::{RenderObserver, accumulate, frame_time, set_time};
 use airlight::scene::{MAX_IMAGE_SIDE, MAX_SPP, Scene};
 use std::ops::Range;
 use std::path::{Path, PathBuf};
@@ -121,10 +122,10 @@ pub struct RenderArgs {
 
 /// Where one frame goes: its images and, on request, its variance and
 /// the layers its EXR images carry.
-struct FrameOutputs {
-    images: Vec<PathBuf>,
-    variance: Option<PathBuf>,
-    layers: Layers,
+pub(crate) struct FrameOutputs {
+    pub images: Vec<PathBuf>,
+    pub variance: Option<PathBuf>,
+    pub layers: Layers,
 }
 
 /// What one `render` command computes: which frames, which samples of
@@ -274,16 +275,15 @@ pub fn render(args: RenderArgs) -> Result<(), String> {
             exposure: scene.settings().exposure,
             tonemap: scene.settings().tonemap,
         };
+        let run =
+            Run { scene: &scene, integrator: integrator.as_ref(), pool: &pool, progress: &progress, label: &label };
         let summary = if plan.partial {
-            let output = &outputs.images[0];
-            render_partial(&scene, integrator.as_ref(), &pool, &progress, output, header, &label, &mut timing)?
+            render_partial(&run, &outputs.images[0], header, &mut timing)?
         } else if progressive {
             let state = State { path: state_path(&outputs.images[0]), header, resume: args.resume };
-            let target = args.target_error;
-            let run = (&pool, &progress, &mut timing);
-            render_progressive(&scene, integrator.as_ref(), run, &outputs, target, &state, &label)?
+            render_progressive(&run, &outputs, args.target_error, &state, &mut timing)?
         } else {
-            render_once(&scene, integrator.as_ref(), &pool, &progress, &outputs, &label, &mut timing)?
+            render_once(&run, &outputs, &mut timing)?
         };
         if !args.quiet && plan.frames.is_none() && !summary.is_empty() {
             progress.println(&summary);
@@ -403,7 +403,12 @@ pub fn numbered(path: &Path, frame: u32) -> PathBuf {
     path.with_file_name(name)
 }
 
-fn write_images(scene: &Scene, image: &Image, outputs: &FrameOutputs, variance: Option<&Image>) -> Result<(), String> {
+pub(crate) fn write_images(
+    scene: &Scene,
+    image: &Image,
+    outputs: &FrameOutputs,
+    variance: Option<&Image>,
+) -> Result<(), String> {
     let s = scene.settings();
     for out in &outputs.images {
         let written = match outputs.layers.channels(variance) {
@@ -415,16 +420,20 @@ fn write_images(scene: &Scene, image: &Image, outputs: &FrameOutputs, variance: 
     Ok(())
 }
 
+/// What renders one frame: the scene as it is at the frame, the
+/// integrator, the worker threads, the progress bar and the frame's label
+/// for it ("path frame 3 of 24").
+pub(crate) struct Run<'a> {
+    pub scene: &'a Scene,
+    pub integrator: &'a dyn Integrator,
+    pub pool: &'a rayon::ThreadPool,
+    pub progress: &'a Progress,
+    pub label: &'a str,
+}
+
 /// All samples in one go; returns nothing to report.
-fn render_once(
-    scene: &Scene,
-    integrator: &dyn Integrator,
-    pool: &rayon::ThreadPool,
-    progress: &Progress,
-    outputs: &FrameOutputs,
-    label: &str,
-    timing: &mut Timing,
-) -> Result<String, String> {
+fn render_once(run: &Run, outputs: &FrameOutputs, timing: &mut Timing) -> Result<String, String> {
+    let Run { scene, integrator, pool, progress, label } = *run;
     let s = scene.settings();
     progress.set_message(format!("{label} {}×{} {} spp", s.width, s.height, s.spp));
     let inc = |n: u64| progress.inc(n);
@@ -436,17 +445,8 @@ fn render_once(
 
 /// One part of a render (`header`'s samples of its rows), written as a
 /// partial EXR.
-#[allow(clippy::too_many_arguments)]
-fn render_partial(
-    scene: &Scene,
-    integrator: &dyn Integrator,
-    pool: &rayon::ThreadPool,
-    progress: &Progress,
-    output: &Path,
-    header: PartialHeader,
-    label: &str,
-    timing: &mut Timing,
-) -> Result<String, String> {
+fn render_partial(run: &Run, output: &Path, header: PartialHeader, timing: &mut Timing) -> Result<String, String> {
+    let Run { scene, integrator, pool, progress, label } = *run;
     progress.set_message(format!("{label} samples {:?} of rows {:?}", header.samples, header.rows));
     let inc = |n: u64| progress.inc(n);
     let observer = RenderObserver { progress: Some(&inc), cancel: None };
@@ -458,103 +458,6 @@ fn render_partial(
     Ok(String::new())
 }
 
-/// Where a progressive render keeps its samples so far, and what they are.
-struct State {
-    path: PathBuf,
-    /// The render's header, for any number of samples.
-    header: PartialHeader,
-    /// Continue from the file if it is there.
-    resume: bool,
-}
-
-/// `NAME.partial.exr` beside the output `NAME.png` or `NAME.exr`.
-fn state_path(output: &Path) -> PathBuf {
-    let stem = output.file_stem().unwrap_or_default().to_string_lossy();
-    output.with_file_name(format!("{stem}.partial.exr"))
-}
-
-/// The progressive render that `state` holds the first samples of, when
-/// resuming and it is there; it must be of this very render.
-fn resumed(scene: &Scene, state: &State, progress: &Progress) -> Result<Progressive, String> {
-    if !state.resume || !state.path.exists() {
-        if state.resume {
-            progress.println(&format!("--resume: no `{}`, starting from the first sample", state.path.display()));
-        }
-        return Ok(Progressive::new(scene));
-    }
-    let name = state.path.display();
-    let part = Partial::read(&state.path).map_err(|e| format!("--resume: {name}: {e}"))?;
-    let (a, b) = (&part.header, &state.header);
-    if (&a.scene, a.seed, a.width, a.height, a.spp, a.frame) != (&b.scene, b.seed, b.width, b.height, b.spp, b.frame)
-        || a.version != b.version
-    {
-        return Err(format!(
-            "--resume: {name} holds samples of another render (scene, seed, size, spp, frame or Airlight version \
-             differ); remove it to start again"
-        ));
-    }
-    if a.samples.start != 0 || a.rows != (0..b.height) || a.samples.end > b.spp as u64 {
-        return Err(format!("--resume: {name} does not hold the first samples of every row"));
-    }
-    progress.println(&format!("resuming from {} samples per pixel in {name}", a.samples.end));
-    progress.inc(a.samples.end * b.width as u64 * b.height as u64);
-    Ok(Progressive::resume(scene, part.sums, a.samples.end as u32))
-}
-
-/// Passes of doubling size, each rewriting the outputs and the samples so
-/// far (atomically, so stopping the render loses at most the pass under
-/// way), until spp or the error target; returns the samples reached and the
-/// estimated error. The samples-so-far file is removed once done.
-fn render_progressive(
-    scene: &Scene,
-    integrator: &dyn Integrator,
-    (pool, progress, timing): (&rayon::ThreadPool, &Progress, &mut Timing),
-    outputs: &FrameOutputs,
-    target_error: Option<f64>,
-    state: &State,
-    label: &str,
-) -> Result<String, String> {
-    let s = scene.settings();
-    let mut progressive = resumed(scene, state, progress)?;
-    let mut error = progressive.estimated_relative_error();
-    if progressive.samples() > 0 && (progressive.finished() || target_error.is_some_and(|target| error < target)) {
-        // Stopped after its last pass, before it tidied up: the images again.
-        let variance = outputs.layers.wants_variance().then(|| progressive.variance());
-        timing.writing(|| write_images(scene, &progressive.image(), outputs, variance.as_ref()))?;
-    }
-    while !progressive.finished() && !target_error.is_some_and(|target| error < target) {
-        let inc = |n: u64| progress.inc(n);
-        let observer = RenderObserver { progress: Some(&inc), cancel: None };
-        timing.image(|| pool.install(|| progressive.pass(scene, integrator, &observer)));
-        error = progressive.estimated_relative_error();
-        progress.set_message(format!(
-            "{label} {}×{} {}/{} spp, est. error {}",
-            s.width,
-            s.height,
-            progressive.samples(),
-            s.spp,
-            format_error(error),
-        ));
-        timing.writing(|| {
-            let variance = outputs.layers.wants_variance().then(|| progressive.variance());
-            write_images(scene, &progressive.image(), outputs, variance.as_ref())?;
-            // The variance is known from the second sample on (EXR: linear,
-            // the tone map is not applied).
-            if let Some(path) = outputs.variance.as_ref().filter(|_| progressive.samples() >= 2) {
-                progressive.variance().save(path).map_err(|e| format!("cannot write `{}`: {e}", path.display()))?;
-            }
-            let header = PartialHeader { samples: 0..progressive.samples() as u64, ..state.header.clone() };
-            Partial { header, sums: progressive.accumulator().clone() }
-                .write(&state.path)
-                .map_err(|e| format!("cannot write `{}`: {e}", state.path.display()))
-        })?;
-    }
-    let _ = std::fs::remove_file(&state.path);
-    // Samples skipped by reaching the target still count toward the bar.
-    let skipped = (s.spp - progressive.samples()) as u64 * s.width as u64 * s.height as u64;
-    progress.inc(skipped);
-    Ok(format!("{} spp, estimated relative error {}", progressive.samples(), format_error(error)))
-}
 /// "this render (N frames of W×H at S spp)", for the forecast.
 fn describe(scene: &Scene, frames: Option<u32>) -> String {
     let s = scene.settings();
@@ -562,7 +465,7 @@ fn describe(scene: &Scene, frames: Option<u32>) -> String {
     format!("this render ({frames}{}×{} at {} spp)", s.width, s.height, s.spp)
 }
 
-fn format_error(error: f64) -> String {
+pub(crate) fn format_error(error: f64) -> String {
     if error.is_finite() { format!("{error:.4}") } else { "unknown (fewer than 2 samples)".into() }
 }
 

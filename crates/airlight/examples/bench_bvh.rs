@@ -7,7 +7,8 @@
 //! with a camera and traces one coherent primary ray per pixel of a
 //! 1024×1024 image, in 8×8 blocks, then one shadow ray from each hit toward
 //! a point light, each on one thread and then on all threads: in packets
-//! (`intersect_packet`, `occluded_packet`, 256 rays a call) and one ray at a
+//! (`intersect_packet`, `occluded_packet`, 256 rays a call: eight rays at a
+//! time where the processor has AVX, and then four, as without it) and one ray at a
 //! time (`intersect`, `occluded`). Then the same rays through obvhs's
 //! compressed 8-wide BVH and its traversal (what Airlight used before the
 //! 4-wide tree), unless `--no-reference` is given. In between, the whole
@@ -111,12 +112,33 @@ fn main() {
         geometry.occluded_packet(segments, blocked);
         blocked.iter().filter(|&&b| b).count() as u64
     };
+    let primary_packet4 = |rays: &[Ray]| {
+        let mut hits = [None; CHUNK];
+        let hits = &mut hits[..rays.len()];
+        geometry.intersect_packet_four_lanes(rays, f32::INFINITY, hits);
+        hits.iter().filter(|h| h.is_some()).count() as u64
+    };
+    let occluded_packet4 = |segments: &[Segment]| {
+        let mut blocked = [false; CHUNK];
+        let blocked = &mut blocked[..segments.len()];
+        geometry.occluded_packet_four_lanes(segments, blocked);
+        blocked.iter().filter(|&&b| b).count() as u64
+    };
     let pp = time(&rays, primary_packet);
     let sp = time(&shadow, occluded_packet);
+    let pp4 = time(&rays, primary_packet4);
+    let sp4 = time(&shadow, occluded_packet4);
     let p = time(&rays, primary);
     let s = time(&shadow, occluded);
     assert_eq!((pp.sum, sp.sum), (p.sum, s.sum), "packets and single rays disagree on hits");
-    report("Airlight BVH4, packets of coherent rays", &pp, &sp, threads);
+    assert_eq!((pp4.sum, sp4.sum), (p.sum, s.sum), "four-lane packets and single rays disagree on hits");
+    report("Airlight BVH4, packets of coherent rays (eight lanes where the CPU has AVX)", &pp, &sp, threads);
+    report("Airlight BVH4, packets of coherent rays, four lanes (SSE)", &pp4, &sp4, threads);
+    println!(
+        "packets, AVX dispatch against four lanes, per CPU second, 1 thread: primary {:.2}×, shadow {:.2}×",
+        pp4.one_cpu / pp.one_cpu,
+        sp4.one_cpu / sp.one_cpu
+    );
     report("Airlight BVH4, one ray at a time", &p, &s, threads);
     println!("  {:.1}% of shadow rays blocked", 100.0 * s.sum as f64 / shadow.len() as f64);
     println!(

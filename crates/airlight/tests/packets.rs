@@ -1,7 +1,8 @@
 //! Packet traversal (`Geometry::intersect_packet`, `occluded_packet`)
 //! against the one-ray queries and testing every primitive: the same hit
 //! (distance and primitive) and the same blocked-or-not for every ray, with
-//! the SSE lanes and with the portable scalar lanes, for coherent camera
+//! the eight AVX lanes (where the processor has AVX: the default there),
+//! the four SSE lanes and the portable scalar lanes, for coherent camera
 //! rays of which some miss, for shadow rays of which some start blocked by
 //! a plane or end before any surface, and for incoherent random rays.
 
@@ -75,19 +76,25 @@ fn agree(geometry: &Geometry, rays: &[Ray], tmax: f32, shadow: &[Segment], check
     }
     let mut native = vec![None; rays.len()];
     geometry.intersect_packet(rays, tmax, &mut native);
+    let mut four = vec![None; rays.len()];
+    geometry.intersect_packet_four_lanes(rays, tmax, &mut four);
     let mut portable = vec![None; rays.len()];
     geometry.intersect_packet_portable(rays, tmax, &mut portable);
     for i in 0..rays.len() {
         assert_eq!(native[i], single[i], "ray {i}: {:?}", rays[i]);
+        assert_eq!(four[i], single[i], "ray {i} (four lanes): {:?}", rays[i]);
         assert_eq!(portable[i], single[i], "ray {i} (portable lanes): {:?}", rays[i]);
     }
     let hits = single.iter().filter(|h| h.is_some()).count();
     let single: Vec<bool> = shadow.iter().map(|s| geometry.occluded(s.origin, s.dir, s.tmax)).collect();
     let mut native = vec![false; shadow.len()];
     geometry.occluded_packet(shadow, &mut native);
+    let mut four = vec![false; shadow.len()];
+    geometry.occluded_packet_four_lanes(shadow, &mut four);
     let mut portable = vec![false; shadow.len()];
     geometry.occluded_packet_portable(shadow, &mut portable);
     assert_eq!(native, single);
+    assert_eq!(four, single);
     assert_eq!(portable, single);
     (hits, single.iter().filter(|&&b| b).count())
 }

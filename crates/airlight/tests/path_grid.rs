@@ -4,6 +4,8 @@
 //! fine quadrature of the density, by the homogeneous medium's closed form,
 //! and by the ray marcher).
 
+mod fog_scenes;
+
 use airlight::film::compare;
 use airlight::geometry::Ray;
 use airlight::integrator::path::tracking::{delta_tracking_passes, ratio_tracking};
@@ -102,22 +104,9 @@ fn delta_and_ratio_tracking_match_a_fine_quadrature_through_a_random_grid() {
     }
 }
 
-/// A light and a camera in a medium, every sample through its pixel's
-/// centre so that integrators trace the same camera rays.
+/// A light and a camera in a medium, 16×16 pixels through their centres.
 fn fog_scene(medium: Medium, light: Light, camera: Camera, spp: u32) -> Scene {
-    SceneBuilder::new()
-        .size(16, 16)
-        .with_settings(|s| {
-            s.spp = spp;
-            s.seed = 5;
-            s.max_distance = 12.0;
-            s.filter = airlight::scene::PixelFilter::Point;
-        })
-        .camera(camera)
-        .light(light)
-        .medium(medium)
-        .build()
-        .unwrap()
+    fog_scenes::fog_scene((16, 5, 12.0), medium, light, camera, spp)
 }
 
 /// The squared difference of two noisy images over the sum of their
@@ -128,18 +117,8 @@ fn error_over_noise(
     b: &Scene,
     ib: &dyn airlight::integrator::Integrator,
 ) -> (f64, f64) {
-    let run = |scene: &Scene, integrator: &dyn airlight::integrator::Integrator| {
-        let sums = accumulate(
-            scene,
-            integrator,
-            0..scene.settings().spp as u64,
-            0..scene.settings().height,
-            &RenderObserver::none(),
-        );
-        (sums.image(), sums.variance().pixels)
-    };
-    let (image_a, var_a) = run(a, ia);
-    let (image_b, var_b) = run(b, ib);
+    let (image_a, var_a) = fog_scenes::image_and_variance(a, ia);
+    let (image_b, var_b) = fog_scenes::image_and_variance(b, ib);
     let squared: f64 = image_a.pixels.iter().zip(&image_b.pixels).map(|(x, y)| (*x - *y).length_squared() as f64).sum();
     let expected: f64 = var_a.iter().chain(&var_b).map(|v| v.element_sum() as f64).sum();
     (squared / expected, compare(&image_a, &image_b).unwrap().rel_rmse)

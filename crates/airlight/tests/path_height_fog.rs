@@ -3,12 +3,14 @@
 //! distances against the closed-form CDF, and single scattering against the
 //! ray marcher.
 
+mod fog_scenes;
+
 use airlight::film::compare;
 use airlight::geometry::Ray;
 use airlight::integrator::path::tracking::free_flight;
 use airlight::integrator::{PathOptions, PathTracer, Raymarch, RaymarchOptions};
 use airlight::prelude::*;
-use airlight::render::{accumulate, render as render_with};
+use airlight::render::render as render_with;
 use airlight::sampling::Sampler;
 
 /// The chance that a flight from o along d collides within t, per unit σt:
@@ -74,30 +76,9 @@ fn height_fog_free_flights_follow_the_closed_form_distribution() {
 }
 
 /// A light in open height fog (base −1, falloff 0.8, as issue 15's
-/// benchmark) seen from `camera`, every sample through its pixel's centre
-/// so that both integrators trace the same camera rays.
+/// benchmark) seen from `camera`, 24×24 pixels through their centres.
 fn open_fog(medium: Medium, light: Light, camera: Camera, spp: u32) -> Scene {
-    SceneBuilder::new()
-        .size(24, 24)
-        .with_settings(|s| {
-            s.spp = spp;
-            s.seed = 3;
-            s.max_distance = 20.0;
-            s.filter = airlight::scene::PixelFilter::Point;
-        })
-        .camera(camera)
-        .light(light)
-        .medium(medium)
-        .build()
-        .unwrap()
-}
-
-/// The path tracer's image at `spp` and the variance of its pixel means,
-/// from the pixels' mean squared samples (s²/n, s² the unbiased variance).
-fn path_with_variance(scene: &Scene, tracer: &PathTracer) -> (Image, Vec<Rgb>) {
-    let (spp, height) = (scene.settings().spp, scene.settings().height);
-    let sums = accumulate(scene, tracer, 0..spp as u64, 0..height, &RenderObserver::none());
-    (sums.image(), sums.variance().pixels)
+    fog_scenes::fog_scene((24, 3, 20.0), medium, light, camera, spp)
 }
 
 #[test]
@@ -124,7 +105,7 @@ fn single_scattering_in_height_fog_agrees_with_marching_within_noise() {
             &Raymarch::new(RaymarchOptions { steps: 2048, jitter: false }),
             &RenderObserver::none(),
         );
-        let (path, variance) = path_with_variance(
+        let (path, variance) = fog_scenes::image_and_variance(
             &open_fog(medium, light, camera, spp),
             &PathTracer::new(PathOptions { max_depth: 1, ..PathOptions::default() }),
         );

@@ -6,7 +6,7 @@
 use super::Ray;
 use super::batch::{comes_before, test_bound};
 use super::bvh4::{self, BoxRay, Bvh4};
-use super::lanes::QuadLanes;
+use super::quad_lanes::QuadLanes;
 use super::sdf::{Sdf, sphere_trace};
 use super::shape::{Shape, box_normal, intersect_box, intersect_quad, intersect_sphere, intersect_triangle};
 use glam::{Affine3A, Mat3, Vec2, Vec3, Vec3A};
@@ -227,7 +227,7 @@ pub struct Geometry {
 const LINEAR_LIMIT: usize = 4;
 /// Up to this many primitives, at least half of them quads and none a
 /// signed distance field, single rays test the quads in SIMD lanes and the
-/// rest one by one rather than through the BVH (lanes.rs): the Cornell box
+/// rest one by one rather than through the BVH (quad_lanes.rs): the Cornell box
 /// (six quads, two rotated boxes) renders faster so, with the same hits.
 const SMALL_LIMIT: usize = 16;
 /// Up to this many primitives, the BVH's leaves hold one primitive each.

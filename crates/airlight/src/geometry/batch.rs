@@ -5,7 +5,10 @@
 //! blocked or not.
 
 use super::accel::Geometry;
-use super::packet::{Lanes, NativeLanes, PACKET, Packet, Scalar4, octant};
+#[cfg(target_arch = "x86_64")]
+use super::lanes::{Avx8, has_avx};
+use super::lanes::{Lanes, NativeLanes, Scalar4};
+use super::packet::{PACKET, Packet, lane_mask, octant};
 use super::{Hit, Ray};
 use glam::Vec3;
 
@@ -24,6 +27,7 @@ const MIN_PACKET: usize = 4;
 /// Calls `f` with the indices of each packet: the rays taken [`PACKET`] at
 /// a time in their order and split by [`octant`] (a packet's rays must
 /// share their direction signs).
+#[inline(always)]
 fn for_each_packet(n: usize, dir: impl Fn(usize) -> Vec3, mut f: impl FnMut(&[usize])) {
     let mut octants = [0u8; PACKET];
     let mut indices = [0usize; PACKET];
@@ -57,8 +61,31 @@ impl Geometry {
     /// `self.intersect(&rays[i], tmax)`, bit for bit, found by tracing
     /// neighbouring rays together. Rays are fastest in the order of nearby
     /// pixels (a tile), whose packets share most of their traversal.
+    /// Eight rays at a time where the processor has AVX, else four.
     pub fn intersect_packet(&self, rays: &[Ray], tmax: f32, hits: &mut [Option<Hit>]) {
+        #[cfg(target_arch = "x86_64")]
+        if has_avx() {
+            // SAFETY: the processor has AVX.
+            return unsafe { self.intersect_packet_avx(rays, tmax, hits) };
+        }
         self.intersect_packet_with::<NativeLanes>(rays, tmax, hits)
+    }
+
+    /// [`Geometry::intersect_packet`] with this target's four-lane
+    /// arithmetic even where AVX is there: for benchmarks and tests.
+    #[doc(hidden)]
+    pub fn intersect_packet_four_lanes(&self, rays: &[Ray], tmax: f32, hits: &mut [Option<Hit>]) {
+        self.intersect_packet_with::<NativeLanes>(rays, tmax, hits)
+    }
+
+    /// The packet traversal compiled for AVX, with eight lanes.
+    ///
+    /// # Safety
+    /// The processor must have AVX ([`has_avx`]).
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx")]
+    unsafe fn intersect_packet_avx(&self, rays: &[Ray], tmax: f32, hits: &mut [Option<Hit>]) {
+        self.intersect_packet_with::<Avx8>(rays, tmax, hits)
     }
 
     /// [`Geometry::intersect_packet`] with the portable (scalar) four-lane
@@ -72,8 +99,31 @@ impl Geometry {
     /// `self.occluded(s.origin, s.dir, s.tmax)` for `s = segments[i]`,
     /// traced in packets. Fastest for segments from nearby points toward
     /// one light.
+    /// Eight rays at a time where the processor has AVX, else four.
     pub fn occluded_packet(&self, segments: &[Segment], blocked: &mut [bool]) {
+        #[cfg(target_arch = "x86_64")]
+        if has_avx() {
+            // SAFETY: the processor has AVX.
+            return unsafe { self.occluded_packet_avx(segments, blocked) };
+        }
         self.occluded_packet_with::<NativeLanes>(segments, blocked)
+    }
+
+    /// [`Geometry::occluded_packet`] with this target's four-lane
+    /// arithmetic even where AVX is there: for benchmarks and tests.
+    #[doc(hidden)]
+    pub fn occluded_packet_four_lanes(&self, segments: &[Segment], blocked: &mut [bool]) {
+        self.occluded_packet_with::<NativeLanes>(segments, blocked)
+    }
+
+    /// The packet shadow test compiled for AVX, with eight lanes.
+    ///
+    /// # Safety
+    /// The processor must have AVX ([`has_avx`]).
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx")]
+    unsafe fn occluded_packet_avx(&self, segments: &[Segment], blocked: &mut [bool]) {
+        self.occluded_packet_with::<Avx8>(segments, blocked)
     }
 
     /// [`Geometry::occluded_packet`] with the portable four-lane arithmetic:
@@ -83,6 +133,9 @@ impl Geometry {
         self.occluded_packet_with::<Scalar4>(segments, blocked)
     }
 
+    // Inlined into the AVX entry points, so that all of it is compiled with
+    // AVX there (the lanes' operations are inlined only into such code).
+    #[inline(always)]
     fn intersect_packet_with<L: Lanes>(&self, rays: &[Ray], tmax: f32, hits: &mut [Option<Hit>]) {
         assert_eq!(rays.len(), hits.len(), "one hit slot per ray");
         let Some(bvh) = self.bvh() else {
@@ -124,6 +177,7 @@ impl Geometry {
         );
     }
 
+    #[inline(always)]
     fn occluded_packet_with<L: Lanes>(&self, segments: &[Segment], blocked: &mut [bool]) {
         assert_eq!(segments.len(), blocked.len(), "one answer per segment");
         super::accel::count_shadow_rays(segments.len() as u64);
@@ -203,8 +257,8 @@ impl Geometry {
         }
         for i in first..first + count {
             let triangle = &self.triangles[i as usize];
-            for (s, lanes) in groups(rays) {
-                let (hit, t) = p.triangle4::<L>(s, triangle);
+            for (s, lanes) in groups::<L>(rays) {
+                let (hit, t) = p.triangle_lanes::<L>(s, triangle);
                 let tmax = L::load(&p.tmax[s..]);
                 let candidates = hit & lanes & (t.lt(tmax) | t.eq(tmax));
                 if candidates == 0 {
@@ -237,8 +291,8 @@ impl Geometry {
         }
         for i in first..first + count {
             let triangle = &self.triangles[i as usize];
-            for (s, lanes) in groups(rays & !blocked) {
-                let (hit, t) = p.triangle4::<L>(s, triangle);
+            for (s, lanes) in groups::<L>(rays & !blocked) {
+                let (hit, t) = p.triangle_lanes::<L>(s, triangle);
                 blocked |= ((hit & lanes & t.lt(L::load(&p.tmax[s..]))) as u64) << s;
             }
             if blocked == rays {
@@ -295,15 +349,15 @@ pub(super) fn bits(mut mask: u64) -> impl Iterator<Item = usize> {
     })
 }
 
-/// The groups of four lanes that hold a ray of `mask`: each group's first
-/// lane and its four bits of `mask`.
+/// The groups of `L::WIDTH` lanes that hold a ray of `mask`: each group's
+/// first lane and its bits of `mask`.
 #[inline(always)]
-pub(super) fn groups(mut mask: u64) -> impl Iterator<Item = (usize, u32)> {
+pub(super) fn groups<L: Lanes>(mut mask: u64) -> impl Iterator<Item = (usize, u32)> {
     std::iter::from_fn(move || {
         (mask != 0).then(|| {
-            let s = (mask.trailing_zeros() as usize) & !3;
-            let lanes = ((mask >> s) & 0xF) as u32;
-            mask &= !(0xFu64 << s);
+            let s = mask.trailing_zeros() as usize / L::WIDTH * L::WIDTH;
+            let lanes = ((mask >> s) & lane_mask::<L>()) as u32;
+            mask &= !(lane_mask::<L>() << s);
             (s, lanes)
         })
     })

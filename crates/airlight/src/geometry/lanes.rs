@@ -1,173 +1,328 @@
-//! A small scene's quads tested all at once, in structure-of-arrays lanes,
-//! instead of through the BVH.
-//!
-//! A room of a handful of quads and boxes (the Cornell box) has too few
-//! primitives for a tree to pay: most rays pass through the boxes of most
-//! nodes, and the traversal's bookkeeping costs more than the tests it
-//! spares. Eight quads side by side take one pass of straight-line
-//! arithmetic that the compiler turns into SIMD. Each lane does exactly the
-//! arithmetic of [`intersect_quad`](super::shape::intersect_quad), in the
-//! same order, so the hits are the same bit for bit as testing the quads
-//! one by one: images do not change, only the time.
+//! Several f32 lanes and the arithmetic the packet traversal (`packet.rs`)
+//! does on them, written once over the [`Lanes`] trait and given by three
+//! types: [`Scalar4`], a loop over four floats (any target, and the tests);
+//! `Sse4`, four lanes in an SSE register (the x86-64 baseline); and
+//! `Avx8`, eight lanes in an AVX register, for processors that have AVX
+//! (found at run time). Every operation is a single IEEE operation per lane
+//! (no fused multiply-add), so the three give the same bits.
 
-use glam::Vec3;
-
-/// Quads per group: two SSE registers per operation, enough independent
-/// work to hide the division's latency.
-const LANES: usize = 8;
-
-/// Eight quads, each field one array across them. Unused lanes have a zero
-/// normal, which the parallel-ray test rejects.
-#[derive(Clone, Debug)]
-struct Group {
-    corner: [[f32; LANES]; 3],
-    edge_u: [[f32; LANES]; 3],
-    edge_v: [[f32; LANES]; 3],
-    /// edge_u × edge_v, and 1/|edge_u × edge_v|².
-    normal: [[f32; LANES]; 3],
-    inv_nn: [f32; LANES],
-    /// The record each lane is, u32::MAX for an unused lane.
-    id: [u32; LANES],
+/// `WIDTH` f32 lanes and the operations the traversal needs. Comparisons
+/// give a mask (bit i for lane i) and, like Rust's scalar comparisons, are
+/// false when either side is NaN.
+pub trait Lanes: Copy {
+    /// How many lanes: 4 or 8.
+    const WIDTH: usize;
+    /// Four lanes with the same arithmetic, for a node's four child boxes.
+    type Four: Lanes;
+    fn splat(x: f32) -> Self;
+    /// Lanes from `s[0..WIDTH]`.
+    fn load(s: &[f32]) -> Self;
+    /// The lanes, in `[0..WIDTH]` of the array (the rest is zero).
+    fn to_array(self) -> [f32; 8];
+    fn add(self, o: Self) -> Self;
+    fn sub(self, o: Self) -> Self;
+    fn mul(self, o: Self) -> Self;
+    fn div(self, o: Self) -> Self;
+    /// `self.min(o)` where neither is NaN.
+    fn min(self, o: Self) -> Self;
+    /// `self.max(o)` where neither is NaN.
+    fn max(self, o: Self) -> Self;
+    fn abs(self) -> Self;
+    fn lt(self, o: Self) -> u32;
+    fn le(self, o: Self) -> u32;
+    fn eq(self, o: Self) -> u32;
 }
 
-/// A scene's quads (record index, corner, edge_u, edge_v) in groups of
-/// [`LANES`], in the order given.
-#[derive(Clone, Debug)]
-pub(super) struct QuadLanes {
-    groups: Vec<Group>,
-}
+/// The portable lanes: a loop over four f32s.
+#[derive(Clone, Copy, Debug)]
+pub struct Scalar4([f32; 4]);
 
-impl QuadLanes {
-    pub fn new(quads: &[(u32, Vec3, Vec3, Vec3)]) -> Self {
-        let groups = quads
-            .chunks(LANES)
-            .map(|chunk| {
-                let mut g = Group {
-                    corner: [[0.0; LANES]; 3],
-                    edge_u: [[0.0; LANES]; 3],
-                    edge_v: [[0.0; LANES]; 3],
-                    normal: [[0.0; LANES]; 3],
-                    inv_nn: [0.0; LANES],
-                    id: [u32::MAX; LANES],
-                };
-                for (k, &(id, corner, edge_u, edge_v)) in chunk.iter().enumerate() {
-                    let n = edge_u.cross(edge_v);
-                    for axis in 0..3 {
-                        g.corner[axis][k] = corner[axis];
-                        g.edge_u[axis][k] = edge_u[axis];
-                        g.edge_v[axis][k] = edge_v[axis];
-                        g.normal[axis][k] = n[axis];
-                    }
-                    g.inv_nn[k] = 1.0 / n.length_squared();
-                    g.id[k] = id;
-                }
-                g
-            })
-            .collect();
-        QuadLanes { groups }
+impl Scalar4 {
+    #[inline(always)]
+    fn map2(self, o: Self, f: impl Fn(f32, f32) -> f32) -> Self {
+        Scalar4(std::array::from_fn(|i| f(self.0[i], o.0[i])))
     }
 
-    /// Calls `found(t, id)`, group by group, for the nearest of the quads
-    /// the ray `o + t·d` meets at 0 < t < tmax (each at that distance, if
-    /// several are): the nearest hit and, of equal ones, any tie-break the
-    /// caller applies come out as from every hit.
-    #[inline]
-    pub fn for_each_nearest(&self, o: Vec3, d: Vec3, tmax: f32, mut found: impl FnMut(f32, u32)) {
-        for g in &self.groups {
-            let t = distances(g, o, d, tmax);
-            let nearest = t.iter().fold(f32::INFINITY, |a, &b| a.min(b));
-            if nearest < tmax {
-                for (&t, &id) in t.iter().zip(&g.id) {
-                    if t == nearest {
-                        found(t, id);
-                    }
-                }
-            }
+    #[inline(always)]
+    fn mask(self, o: Self, f: impl Fn(f32, f32) -> bool) -> u32 {
+        (0..4).fold(0, |m, i| m | ((f(self.0[i], o.0[i]) as u32) << i))
+    }
+}
+
+impl Lanes for Scalar4 {
+    const WIDTH: usize = 4;
+    type Four = Scalar4;
+    #[inline(always)]
+    fn splat(x: f32) -> Self {
+        Scalar4([x; 4])
+    }
+    #[inline(always)]
+    fn load(s: &[f32]) -> Self {
+        Scalar4([s[0], s[1], s[2], s[3]])
+    }
+    #[inline(always)]
+    fn to_array(self) -> [f32; 8] {
+        let mut out = [0.0; 8];
+        out[..4].copy_from_slice(&self.0);
+        out
+    }
+    #[inline(always)]
+    fn add(self, o: Self) -> Self {
+        self.map2(o, |a, b| a + b)
+    }
+    #[inline(always)]
+    fn sub(self, o: Self) -> Self {
+        self.map2(o, |a, b| a - b)
+    }
+    #[inline(always)]
+    fn mul(self, o: Self) -> Self {
+        self.map2(o, |a, b| a * b)
+    }
+    #[inline(always)]
+    fn div(self, o: Self) -> Self {
+        self.map2(o, |a, b| a / b)
+    }
+    #[inline(always)]
+    fn min(self, o: Self) -> Self {
+        self.map2(o, |a, b| if a < b { a } else { b })
+    }
+    #[inline(always)]
+    fn max(self, o: Self) -> Self {
+        self.map2(o, |a, b| if a > b { a } else { b })
+    }
+    #[inline(always)]
+    fn abs(self) -> Self {
+        Scalar4(self.0.map(f32::abs))
+    }
+    #[inline(always)]
+    fn lt(self, o: Self) -> u32 {
+        self.mask(o, |a, b| a < b)
+    }
+    #[inline(always)]
+    fn le(self, o: Self) -> u32 {
+        self.mask(o, |a, b| a <= b)
+    }
+    #[inline(always)]
+    fn eq(self, o: Self) -> u32 {
+        self.mask(o, |a, b| a == b)
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+pub use x86::{Avx8, Sse4, has_avx};
+
+#[cfg(target_arch = "x86_64")]
+mod x86 {
+    use super::Lanes;
+    use std::arch::x86_64::*;
+
+    /// Four lanes in an SSE register.
+    #[derive(Clone, Copy, Debug)]
+    pub struct Sse4(__m128);
+
+    // SAFETY (every function below): SSE and SSE2 are part of the x86-64
+    // baseline; `load` reads four f32s from a slice of at least four (the
+    // indexing checks it) with an unaligned load.
+    impl Lanes for Sse4 {
+        const WIDTH: usize = 4;
+        type Four = Sse4;
+        #[inline(always)]
+        fn splat(x: f32) -> Self {
+            unsafe { Sse4(_mm_set1_ps(x)) }
+        }
+        #[inline(always)]
+        fn load(s: &[f32]) -> Self {
+            let s = &s[..4];
+            unsafe { Sse4(_mm_loadu_ps(s.as_ptr())) }
+        }
+        #[inline(always)]
+        fn to_array(self) -> [f32; 8] {
+            let mut out = [0.0; 8];
+            unsafe { _mm_storeu_ps(out.as_mut_ptr(), self.0) };
+            out
+        }
+        #[inline(always)]
+        fn add(self, o: Self) -> Self {
+            unsafe { Sse4(_mm_add_ps(self.0, o.0)) }
+        }
+        #[inline(always)]
+        fn sub(self, o: Self) -> Self {
+            unsafe { Sse4(_mm_sub_ps(self.0, o.0)) }
+        }
+        #[inline(always)]
+        fn mul(self, o: Self) -> Self {
+            unsafe { Sse4(_mm_mul_ps(self.0, o.0)) }
+        }
+        #[inline(always)]
+        fn div(self, o: Self) -> Self {
+            unsafe { Sse4(_mm_div_ps(self.0, o.0)) }
+        }
+        #[inline(always)]
+        fn min(self, o: Self) -> Self {
+            unsafe { Sse4(_mm_min_ps(self.0, o.0)) }
+        }
+        #[inline(always)]
+        fn max(self, o: Self) -> Self {
+            unsafe { Sse4(_mm_max_ps(self.0, o.0)) }
+        }
+        #[inline(always)]
+        fn abs(self) -> Self {
+            unsafe { Sse4(_mm_and_ps(self.0, _mm_castsi128_ps(_mm_set1_epi32(i32::MAX)))) }
+        }
+        #[inline(always)]
+        fn lt(self, o: Self) -> u32 {
+            unsafe { _mm_movemask_ps(_mm_cmplt_ps(self.0, o.0)) as u32 }
+        }
+        #[inline(always)]
+        fn le(self, o: Self) -> u32 {
+            unsafe { _mm_movemask_ps(_mm_cmple_ps(self.0, o.0)) as u32 }
+        }
+        #[inline(always)]
+        fn eq(self, o: Self) -> u32 {
+            unsafe { _mm_movemask_ps(_mm_cmpeq_ps(self.0, o.0)) as u32 }
         }
     }
 
-    /// Whether any quad meets the ray at 0 < t < tmax.
+    /// Whether this processor has AVX (checked once, then cached by std).
     #[inline]
-    pub fn any_hit(&self, o: Vec3, d: Vec3, tmax: f32) -> bool {
-        self.groups.iter().any(|g| distances(g, o, d, tmax).iter().any(|&t| t < tmax))
+    pub fn has_avx() -> bool {
+        std::arch::is_x86_feature_detected!("avx")
+    }
+
+    /// Eight lanes in an AVX register. Only code compiled with AVX enabled
+    /// (`#[target_feature(enable = "avx")]`, entered after [`has_avx`]) may
+    /// use it: its operations are inlined there; elsewhere they would be
+    /// calls to instructions the processor may lack.
+    #[derive(Clone, Copy, Debug)]
+    pub struct Avx8(__m256);
+
+    // SAFETY (every function below): an `Avx8` is only made and used in
+    // functions that run after `has_avx()` said yes (the type's contract);
+    // `load` reads eight f32s from a slice of at least eight (the indexing
+    // checks it) with an unaligned load. The comparisons are the ordered,
+    // quiet predicates: false with a NaN, as SSE's `cmplt`/`cmple`/`cmpeq`.
+    impl Lanes for Avx8 {
+        const WIDTH: usize = 8;
+        type Four = Sse4;
+        #[inline(always)]
+        fn splat(x: f32) -> Self {
+            unsafe { Avx8(_mm256_set1_ps(x)) }
+        }
+        #[inline(always)]
+        fn load(s: &[f32]) -> Self {
+            let s = &s[..8];
+            unsafe { Avx8(_mm256_loadu_ps(s.as_ptr())) }
+        }
+        #[inline(always)]
+        fn to_array(self) -> [f32; 8] {
+            let mut out = [0.0; 8];
+            unsafe { _mm256_storeu_ps(out.as_mut_ptr(), self.0) };
+            out
+        }
+        #[inline(always)]
+        fn add(self, o: Self) -> Self {
+            unsafe { Avx8(_mm256_add_ps(self.0, o.0)) }
+        }
+        #[inline(always)]
+        fn sub(self, o: Self) -> Self {
+            unsafe { Avx8(_mm256_sub_ps(self.0, o.0)) }
+        }
+        #[inline(always)]
+        fn mul(self, o: Self) -> Self {
+            unsafe { Avx8(_mm256_mul_ps(self.0, o.0)) }
+        }
+        #[inline(always)]
+        fn div(self, o: Self) -> Self {
+            unsafe { Avx8(_mm256_div_ps(self.0, o.0)) }
+        }
+        #[inline(always)]
+        fn min(self, o: Self) -> Self {
+            unsafe { Avx8(_mm256_min_ps(self.0, o.0)) }
+        }
+        #[inline(always)]
+        fn max(self, o: Self) -> Self {
+            unsafe { Avx8(_mm256_max_ps(self.0, o.0)) }
+        }
+        #[inline(always)]
+        fn abs(self) -> Self {
+            unsafe { Avx8(_mm256_and_ps(self.0, _mm256_castsi256_ps(_mm256_set1_epi32(i32::MAX)))) }
+        }
+        #[inline(always)]
+        fn lt(self, o: Self) -> u32 {
+            unsafe { _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LT_OQ>(self.0, o.0)) as u32 }
+        }
+        #[inline(always)]
+        fn le(self, o: Self) -> u32 {
+            unsafe { _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(self.0, o.0)) as u32 }
+        }
+        #[inline(always)]
+        fn eq(self, o: Self) -> u32 {
+            unsafe { _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_EQ_OQ>(self.0, o.0)) as u32 }
+        }
     }
 }
 
-/// Each lane's hit distance in (0, tmax), or infinity: `intersect_quad`'s
-/// operations lane by lane, without branches (a miss selects infinity).
-// One index across the group's many arrays, and `&` rather than `&&` and
-// range `contains`: straight-line code the compiler vectorises.
-#[allow(clippy::needless_range_loop, clippy::manual_range_contains)]
-#[inline(always)]
-fn distances(g: &Group, o: Vec3, d: Vec3, tmax: f32) -> [f32; LANES] {
-    let mut out = [f32::INFINITY; LANES];
-    for k in 0..LANES {
-        let [nx, ny, nz] = [g.normal[0][k], g.normal[1][k], g.normal[2][k]];
-        let [cx, cy, cz] = [g.corner[0][k], g.corner[1][k], g.corner[2][k]];
-        let [ux, uy, uz] = [g.edge_u[0][k], g.edge_u[1][k], g.edge_u[2][k]];
-        let [vx, vy, vz] = [g.edge_v[0][k], g.edge_v[1][k], g.edge_v[2][k]];
-        // n·d, n·(corner − o)
-        let denom = (nx * d.x) + (ny * d.y) + (nz * d.z);
-        let t = ((nx * (cx - o.x)) + (ny * (cy - o.y)) + (nz * (cz - o.z))) / denom;
-        // rel = o + d·t − corner
-        let (rx, ry, rz) = ((o.x + d.x * t) - cx, (o.y + d.y * t) - cy, (o.z + d.z * t) - cz);
-        // (rel × edge_v)·n and (edge_u × rel)·n
-        let (ax, ay, az) = (ry * vz - vy * rz, rz * vx - vz * rx, rx * vy - vx * ry);
-        let (bx, by, bz) = (uy * rz - ry * uz, uz * rx - rz * ux, ux * ry - rx * uy);
-        let alpha = ((ax * nx) + (ay * ny) + (az * nz)) * g.inv_nn[k];
-        let beta = ((bx * nx) + (by * ny) + (bz * nz)) * g.inv_nn[k];
-        // (A NaN denominator fails here, and its NaN t fails in the original.)
-        let hit = (denom.abs() >= 1e-20)
-            & (t > 0.0)
-            & (t < tmax)
-            & (alpha >= 0.0)
-            & (alpha <= 1.0)
-            & (beta >= 0.0)
-            & (beta <= 1.0);
-        out[k] = if hit { t } else { f32::INFINITY };
-    }
-    out
-}
+/// The four-lane type this target's packets use without AVX.
+#[cfg(target_arch = "x86_64")]
+pub type NativeLanes = Sse4;
+#[cfg(not(target_arch = "x86_64"))]
+pub type NativeLanes = Scalar4;
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::geometry::intersect_quad;
-    use crate::sampling::{Sampler, uniform_sphere};
+
+    /// Values that probe the edge cases: signed zeros, infinities, NaN,
+    /// denormals, and ordinary numbers.
+    const VALUES: [f32; 8] = [0.0, -0.0, 1.5, -2.25, f32::INFINITY, f32::NEG_INFINITY, f32::NAN, 1e-40];
+
+    /// Every operation of `L` against the scalar lanes, on all pairs of
+    /// [`VALUES`], bit for bit.
+    fn same_as_scalar<L: Lanes>() {
+        let bits = |v: [f32; 8]| v.map(f32::to_bits);
+        for (i, &a) in VALUES.iter().enumerate() {
+            // Each lane a different b: a rotation of the values.
+            let b: [f32; 8] = std::array::from_fn(|k| VALUES[(i + k) % 8]);
+            let (x, y) = (L::splat(a), L::load(&b));
+            for (k, &b) in b.iter().take(L::WIDTH).enumerate() {
+                let (s, t) = (Scalar4::splat(a), Scalar4::splat(b));
+                let lane = |v: L| v.to_array()[k].to_bits();
+                let one = |v: Scalar4| v.to_array()[0].to_bits();
+                assert_eq!(lane(x.add(y)), one(s.add(t)), "{a} + {b}");
+                assert_eq!(lane(x.sub(y)), one(s.sub(t)), "{a} - {b}");
+                assert_eq!(lane(x.mul(y)), one(s.mul(t)), "{a} * {b}");
+                let (q, r) = (x.div(y).to_array()[k], s.div(t).to_array()[0]);
+                assert!(q.to_bits() == r.to_bits() || (q.is_nan() && r.is_nan()), "{a} / {b}");
+                if !a.is_nan() && !b.is_nan() {
+                    assert_eq!(lane(x.min(y)), one(s.min(t)), "min({a}, {b})");
+                    assert_eq!(lane(x.max(y)), one(s.max(t)), "max({a}, {b})");
+                }
+                assert_eq!(x.lt(y) >> k & 1, s.lt(t) & 1, "{a} < {b}");
+                assert_eq!(x.le(y) >> k & 1, s.le(t) & 1, "{a} <= {b}");
+                assert_eq!(x.eq(y) >> k & 1, s.eq(t) & 1, "{a} == {b}");
+            }
+            assert_eq!(bits(y.abs().to_array())[..L::WIDTH], bits(b.map(f32::abs))[..L::WIDTH]);
+            assert_eq!(x.lt(y) >> L::WIDTH, 0, "no bits past the lanes");
+        }
+    }
 
     #[test]
-    fn lanes_give_the_one_by_one_distances_bit_for_bit() {
-        // Eleven random quads (a full group and a partial one), random rays
-        // from inside their bounds: every lane's hit against intersect_quad.
-        let mut s = Sampler::for_pixel(5, 6, 7);
-        let mut v = || Vec3::new(s.next(), s.next(), s.next()) - 0.5;
-        let quads: Vec<(u32, Vec3, Vec3, Vec3)> = (0..11).map(|i| (i, v() * 4.0, v() * 3.0, v() * 3.0)).collect();
-        let lanes = QuadLanes::new(&quads);
-        let mut s = Sampler::for_pixel(8, 9, 10);
-        let mut hits = 0;
-        for i in 0..20_000 {
-            let o = (Vec3::new(s.next(), s.next(), s.next()) - 0.5) * 4.0;
-            let d = uniform_sphere(s.next2());
-            let tmax = if i % 2 == 0 { f32::INFINITY } else { 3.0 * s.next() };
-            let want: Vec<f32> = quads.iter().map(|&(_, c, u, w)| intersect_quad(c, u, w, o, d, 0.0, tmax)).collect();
-            for g in &lanes.groups {
-                let got = distances(g, o, d, tmax);
-                for (k, &id) in g.id.iter().enumerate() {
-                    let want = want.get(id as usize).copied().unwrap_or(f32::INFINITY);
-                    assert_eq!(got[k].to_bits(), want.to_bits(), "ray {o} {d} {tmax} quad {id}");
-                }
-            }
-            // The nearest per group: no quad of the group nearer.
-            let mut nearest = Vec::new();
-            lanes.for_each_nearest(o, d, tmax, |t, id| nearest.push((t, id)));
-            for (t, id) in nearest {
-                assert_eq!(t, want[id as usize]);
-                let group = id as usize / LANES;
-                assert!(want[group * LANES..].iter().take(LANES).all(|&w| w >= t));
-            }
-            assert_eq!(lanes.any_hit(o, d, tmax), want.iter().any(|t| t.is_finite()));
-            hits += want.iter().filter(|t| t.is_finite()).count();
+    fn native_lanes_compute_what_scalar_lanes_compute() {
+        same_as_scalar::<NativeLanes>();
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[test]
+    fn avx_lanes_compute_what_scalar_lanes_compute() {
+        if !has_avx() {
+            eprintln!("skipped: this processor has no AVX");
+            return;
         }
-        assert!(hits > 2000, "hits {hits}");
+        #[target_feature(enable = "avx")]
+        unsafe fn check() {
+            same_as_scalar::<Avx8>();
+        }
+        // SAFETY: the processor has AVX (checked above).
+        unsafe { check() }
     }
 }

@@ -7,197 +7,25 @@
 //! range of origins and of reciprocal directions, Boulos et al., "Packet-based
 //! Whitted and distribution ray tracing", 2007), which drops children that no
 //! ray of the packet can enter without testing any ray. A child that passes
-//! is then tested ray by ray, four rays at a time, when it is visited (so
-//! that the rays' nearest hits found meanwhile cull it), and only the rays
-//! that enter it go on. Leaves test their triangles against four rays at a
-//! time with the same arithmetic, operation for operation, as the one-ray
+//! is then tested ray by ray, a group of rays at a time (four or eight, the
+//! width of the [`Lanes`]), when it is visited (so that the rays' nearest
+//! hits found meanwhile cull it), and only the rays that enter it go on.
+//! Leaves test their triangles against a group of rays at a time with the
+//! same arithmetic, operation for operation, as the one-ray
 //! [`intersect_triangle`](super::intersect_triangle), so a ray's hit
 //! distance is the same bits whichever way it is traced.
 //!
 //! All rays of a packet share their direction's sign on each axis (the
 //! caller groups rays so), which makes the near plane of every box the same
-//! for all of them. Four-ray arithmetic is written once over [`Lanes`]: SSE
-//! on x86-64 (its baseline), and a scalar type with the same operations,
-//! which other targets use and the tests run too.
+//! for all of them. The arithmetic is written once over [`Lanes`]
+//! (`lanes.rs`).
 
 use super::bvh4::{Bvh4, COUNT_MASK, FAR_SCALE, LEAF_MIXED, Node4, STACK_SIZE, far_row};
+use super::lanes::Lanes;
 use glam::Vec3;
 
 /// The most rays a packet holds: one bit each in a `u64` mask.
 pub const PACKET: usize = 64;
-
-/// Four f32 lanes and the operations the traversal needs. Comparisons give
-/// a 4-bit mask (bit i for lane i) and, like Rust's scalar comparisons, are
-/// false when either side is NaN.
-pub trait Lanes: Copy {
-    fn splat(x: f32) -> Self;
-    /// Lanes from `s[0..4]`.
-    fn load(s: &[f32]) -> Self;
-    fn to_array(self) -> [f32; 4];
-    fn add(self, o: Self) -> Self;
-    fn sub(self, o: Self) -> Self;
-    fn mul(self, o: Self) -> Self;
-    fn div(self, o: Self) -> Self;
-    /// `self.min(o)` where neither is NaN.
-    fn min(self, o: Self) -> Self;
-    /// `self.max(o)` where neither is NaN.
-    fn max(self, o: Self) -> Self;
-    fn abs(self) -> Self;
-    fn lt(self, o: Self) -> u32;
-    fn le(self, o: Self) -> u32;
-    fn eq(self, o: Self) -> u32;
-}
-
-/// The portable lanes: a loop over four f32s.
-#[derive(Clone, Copy, Debug)]
-pub struct Scalar4([f32; 4]);
-
-impl Scalar4 {
-    #[inline(always)]
-    fn map2(self, o: Self, f: impl Fn(f32, f32) -> f32) -> Self {
-        Scalar4(std::array::from_fn(|i| f(self.0[i], o.0[i])))
-    }
-
-    #[inline(always)]
-    fn mask(self, o: Self, f: impl Fn(f32, f32) -> bool) -> u32 {
-        (0..4).fold(0, |m, i| m | ((f(self.0[i], o.0[i]) as u32) << i))
-    }
-}
-
-impl Lanes for Scalar4 {
-    #[inline(always)]
-    fn splat(x: f32) -> Self {
-        Scalar4([x; 4])
-    }
-    #[inline(always)]
-    fn load(s: &[f32]) -> Self {
-        Scalar4([s[0], s[1], s[2], s[3]])
-    }
-    #[inline(always)]
-    fn to_array(self) -> [f32; 4] {
-        self.0
-    }
-    #[inline(always)]
-    fn add(self, o: Self) -> Self {
-        self.map2(o, |a, b| a + b)
-    }
-    #[inline(always)]
-    fn sub(self, o: Self) -> Self {
-        self.map2(o, |a, b| a - b)
-    }
-    #[inline(always)]
-    fn mul(self, o: Self) -> Self {
-        self.map2(o, |a, b| a * b)
-    }
-    #[inline(always)]
-    fn div(self, o: Self) -> Self {
-        self.map2(o, |a, b| a / b)
-    }
-    #[inline(always)]
-    fn min(self, o: Self) -> Self {
-        self.map2(o, |a, b| if a < b { a } else { b })
-    }
-    #[inline(always)]
-    fn max(self, o: Self) -> Self {
-        self.map2(o, |a, b| if a > b { a } else { b })
-    }
-    #[inline(always)]
-    fn abs(self) -> Self {
-        Scalar4(self.0.map(f32::abs))
-    }
-    #[inline(always)]
-    fn lt(self, o: Self) -> u32 {
-        self.mask(o, |a, b| a < b)
-    }
-    #[inline(always)]
-    fn le(self, o: Self) -> u32 {
-        self.mask(o, |a, b| a <= b)
-    }
-    #[inline(always)]
-    fn eq(self, o: Self) -> u32 {
-        self.mask(o, |a, b| a == b)
-    }
-}
-
-#[cfg(target_arch = "x86_64")]
-pub use sse::Sse4;
-
-#[cfg(target_arch = "x86_64")]
-mod sse {
-    use super::Lanes;
-    use std::arch::x86_64::*;
-
-    /// Four lanes in an SSE register.
-    #[derive(Clone, Copy, Debug)]
-    pub struct Sse4(__m128);
-
-    // SAFETY (every function below): SSE and SSE2 are part of the x86-64
-    // baseline; `load` reads four f32s from a slice of at least four (the
-    // indexing checks it) with an unaligned load.
-    impl Lanes for Sse4 {
-        #[inline(always)]
-        fn splat(x: f32) -> Self {
-            unsafe { Sse4(_mm_set1_ps(x)) }
-        }
-        #[inline(always)]
-        fn load(s: &[f32]) -> Self {
-            let s = &s[..4];
-            unsafe { Sse4(_mm_loadu_ps(s.as_ptr())) }
-        }
-        #[inline(always)]
-        fn to_array(self) -> [f32; 4] {
-            let mut out = [0.0; 4];
-            unsafe { _mm_storeu_ps(out.as_mut_ptr(), self.0) };
-            out
-        }
-        #[inline(always)]
-        fn add(self, o: Self) -> Self {
-            unsafe { Sse4(_mm_add_ps(self.0, o.0)) }
-        }
-        #[inline(always)]
-        fn sub(self, o: Self) -> Self {
-            unsafe { Sse4(_mm_sub_ps(self.0, o.0)) }
-        }
-        #[inline(always)]
-        fn mul(self, o: Self) -> Self {
-            unsafe { Sse4(_mm_mul_ps(self.0, o.0)) }
-        }
-        #[inline(always)]
-        fn div(self, o: Self) -> Self {
-            unsafe { Sse4(_mm_div_ps(self.0, o.0)) }
-        }
-        #[inline(always)]
-        fn min(self, o: Self) -> Self {
-            unsafe { Sse4(_mm_min_ps(self.0, o.0)) }
-        }
-        #[inline(always)]
-        fn max(self, o: Self) -> Self {
-            unsafe { Sse4(_mm_max_ps(self.0, o.0)) }
-        }
-        #[inline(always)]
-        fn abs(self) -> Self {
-            unsafe { Sse4(_mm_and_ps(self.0, _mm_castsi128_ps(_mm_set1_epi32(i32::MAX)))) }
-        }
-        #[inline(always)]
-        fn lt(self, o: Self) -> u32 {
-            unsafe { _mm_movemask_ps(_mm_cmplt_ps(self.0, o.0)) as u32 }
-        }
-        #[inline(always)]
-        fn le(self, o: Self) -> u32 {
-            unsafe { _mm_movemask_ps(_mm_cmple_ps(self.0, o.0)) as u32 }
-        }
-        #[inline(always)]
-        fn eq(self, o: Self) -> u32 {
-            unsafe { _mm_movemask_ps(_mm_cmpeq_ps(self.0, o.0)) as u32 }
-        }
-    }
-}
-
-/// The lanes this target traces with.
-#[cfg(target_arch = "x86_64")]
-pub type NativeLanes = Sse4;
-#[cfg(not(target_arch = "x86_64"))]
-pub type NativeLanes = Scalar4;
 
 /// Up to [`PACKET`] rays in structure of arrays, all with the same direction
 /// signs, with each ray's nearest hit so far (`tmax`, and `id`, u32::MAX
@@ -315,16 +143,15 @@ impl Packet {
     }
 
     /// Of the rays in `mask`, those whose segment [0, tmax] enters child
-    /// `c`'s box of `node`: the single-ray test, four rays at a time.
+    /// `c`'s box of `node`: the single-ray test, `L::WIDTH` rays at a time.
     #[inline(always)]
     fn enter<L: Lanes>(&self, node: &Node4, c: usize, mask: u64) -> u64 {
         let mut out = 0;
         let mut groups = mask;
         while groups != 0 {
-            let g = groups.trailing_zeros() as usize / 4;
-            let bits = (mask >> (4 * g)) & 0xF;
-            groups &= !(0xFu64 << (4 * g));
-            let s = 4 * g;
+            let s = groups.trailing_zeros() as usize / L::WIDTH * L::WIDTH;
+            let bits = (mask >> s) & lane_mask::<L>();
+            groups &= !(lane_mask::<L>() << s);
             let slab = |row: usize, a: usize| {
                 L::splat(node.bounds[row][c]).sub(L::load(&self.origin[a][s..])).mul(L::load(&self.inv_dir[a][s..]))
             };
@@ -349,6 +176,7 @@ impl Packet {
     /// enters is dropped.
     #[inline(always)]
     fn children<L: Lanes>(&self, node: &Node4) -> (u32, [f32; 4]) {
+        debug_assert_eq!(L::WIDTH, 4, "one lane per child");
         let range = |row: usize, a: usize| {
             let plane = L::load(&node.bounds[row]);
             let (d_lo, d_hi) = (plane.sub(L::splat(self.origin_hi[a])), plane.sub(L::splat(self.origin_lo[a])));
@@ -364,14 +192,15 @@ impl Packet {
         ];
         let tnear = n[0].max(n[1]).max(n[2].max(L::splat(0.0)));
         let tfar = f[0].min(f[1]).min(f[2].min(L::splat(self.tmax_hi))).mul(L::splat(FAR_SCALE));
-        (tnear.le(tfar), tnear.to_array())
+        let t = tnear.to_array();
+        (tnear.le(tfar), [t[0], t[1], t[2], t[3]])
     }
 
-    /// Möller–Trumbore against rays `s..s + 4`, operation for operation as
+    /// Möller–Trumbore against rays `s..s + L::WIDTH`, operation for operation as
     /// [`super::intersect_triangle`]: the mask of lanes with a hit at t > 0
     /// (no upper bound applied) and the lanes' t.
     #[inline(always)]
-    pub fn triangle4<L: Lanes>(&self, s: usize, triangle: &[Vec3; 3]) -> (u32, L) {
+    pub fn triangle_lanes<L: Lanes>(&self, s: usize, triangle: &[Vec3; 3]) -> (u32, L) {
         let d = [L::load(&self.dir[0][s..]), L::load(&self.dir[1][s..]), L::load(&self.dir[2][s..])];
         let o = [L::load(&self.origin[0][s..]), L::load(&self.origin[1][s..]), L::load(&self.origin[2][s..])];
         // Each component read on its own: copying the 12-byte vectors whole
@@ -384,7 +213,7 @@ impl Packet {
         let dot = |a: &[L; 3], b: &[L; 3]| a[0].mul(b[0]).add(a[1].mul(b[1])).add(a[2].mul(b[2]));
         let pvec = cross(&d, &e2);
         let det = dot(&e1, &pvec);
-        let ok_det = !det.abs().lt(L::splat(1e-20)) & 0xF;
+        let ok_det = !det.abs().lt(L::splat(1e-20)) & lane_mask::<L>() as u32;
         let inv_det = L::splat(1.0).div(det);
         let tvec = [o[0].sub(L::splat(v0.x)), o[1].sub(L::splat(v0.y)), o[2].sub(L::splat(v0.z))];
         let u = dot(&tvec, &pvec).mul(inv_det);
@@ -394,8 +223,14 @@ impl Packet {
         let miss_v = v.lt(L::splat(0.0)) | L::splat(1.0).lt(u.add(v));
         let t = dot(&e2, &qvec).mul(inv_det);
         let ok_t = L::splat(0.0).lt(t);
-        (ok_det & ok_u & !miss_v & ok_t & 0xF, t)
+        (ok_det & ok_u & !miss_v & ok_t, t)
     }
+}
+
+/// The mask of one group of `L::WIDTH` lanes.
+#[inline(always)]
+pub fn lane_mask<L: Lanes>() -> u64 {
+    (1u64 << L::WIDTH) - 1
 }
 
 /// Asks the processor to bring the cache lines of `value` closer (a hint:
@@ -431,6 +266,7 @@ impl Bvh4 {
     /// for a nearest-hit query, and returns the rays that are done (for an
     /// any-hit query: blocked), which the traversal then drops. Children
     /// are visited nearest first by the packet's interval bound.
+    #[inline(always)]
     pub fn packet<L: Lanes>(
         &self,
         packet: &mut Packet,
@@ -446,7 +282,7 @@ impl Bvh4 {
         loop {
             if let Some((index, rays)) = expand.take() {
                 let node = &self.nodes[index];
-                let (bits, tnear) = packet.children::<L>(node);
+                let (bits, tnear) = packet.children::<L::Four>(node);
                 // Push the farthest first, so that the nearest is popped first.
                 let mut order = [(0usize, 0.0f32); 4];
                 let mut n = 0;

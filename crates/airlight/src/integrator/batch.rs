@@ -6,8 +6,8 @@
 
 use crate::Rgb;
 use crate::geometry::{Hit, Ray, Segment, offset_origin};
-use crate::sampling::{Sampler, keyed2};
-use crate::scene::{Scene, light_numbers};
+use crate::sampling::Sampler;
+use crate::scene::Scene;
 
 /// A light's contribution to one sample, counted if its shadow ray is clear.
 struct Candidate {
@@ -34,29 +34,13 @@ pub fn first_surface_batch(scene: &Scene, rays: &[Ray], samplers: &mut [Sampler]
         };
         let surface = geometry.surface(ray, hit);
         // What `surface_radiance` computes, with its shadow rays put off.
-        let wo = -ray.dir;
-        out[k] = match surface.emitter {
-            Some(light) => scene.lights()[light as usize].emitted(surface.n, ray.dir),
-            None => Rgb::ZERO,
-        };
-        let material = scene.material_at(&surface);
-        let key = sampler.next_key();
-        scene.for_each_light_at(surface.p, |index, _| {
-            let u = light_numbers(keyed2(key, index as u64));
-            let Some(sample) = scene.sample_light(index, surface.p, u) else { return };
-            let cos = sample.wi.dot(surface.n).abs();
-            if cos == 0.0 {
-                return;
-            }
-            let f = material.brdf(surface.p, surface.n, wo, sample.wi);
-            if f == Rgb::ZERO {
-                return;
-            }
+        out[k] = super::emitted(scene, ray, &surface);
+        super::for_each_light_term(scene, ray, &surface, sampler, |index, sample, contribution| {
             let origin = offset_origin(surface.p, surface.n, sample.wi);
             candidates.push(Candidate {
                 sample: k,
                 light: index,
-                contribution: f * sample.weight * cos,
+                contribution,
                 segment: scene.light_segment(surface.p, origin, sample.wi, sample.distance),
             });
         });

@@ -241,8 +241,8 @@ pub fn no_extra(_: &SurfaceHit) -> Rgb {
 /// Radiance leaving a surface toward `-ray.dir`: its emission plus direct
 /// light from every light, one sample per area light, with shadow rays. In a
 /// medium, light arriving from each light is attenuated on its way.
-/// (`batch.rs` computes the same without a medium for many rays at once:
-/// a change here must be made there too; the render tests compare them.)
+/// (`batch.rs` computes the same without a medium for many rays at once,
+/// from the same [`emitted`] and [`for_each_light_term`].)
 pub fn surface_radiance(
     scene: &Scene,
     ray: &Ray,
@@ -250,11 +250,40 @@ pub fn surface_radiance(
     sampler: &mut Sampler,
     medium: Option<&Medium>,
 ) -> Rgb {
-    let wo = -ray.dir;
-    let mut radiance = match surface.emitter {
+    let mut radiance = emitted(scene, ray, surface);
+    for_each_light_term(scene, ray, surface, sampler, |_, sample, mut contribution| {
+        if !scene.unoccluded(surface.p, Some(surface.n), sample) {
+            return;
+        }
+        if let Some(m) = medium {
+            let origin = crate::geometry::offset_origin(surface.p, surface.n, sample.wi);
+            contribution *= m.transmittance(origin, sample.wi, 0.0, scene.light_distance(sample.distance));
+        }
+        radiance += contribution;
+    });
+    radiance
+}
+
+/// What a surface emits toward `-ray.dir` (zero unless it is a light's).
+pub(crate) fn emitted(scene: &Scene, ray: &Ray, surface: &SurfaceHit) -> Rgb {
+    match surface.emitter {
         Some(light) => scene.lights()[light as usize].emitted(surface.n, ray.dir),
         None => Rgb::ZERO,
-    };
+    }
+}
+
+/// Calls `term(light, sample, f · weight · |cos|)` for one sample of each
+/// light that may reach the surface, in the lights' order, before any
+/// shadow ray: the terms that direct light adds where the light is seen.
+/// Takes one key from `sampler`, whatever the number of lights.
+pub(crate) fn for_each_light_term(
+    scene: &Scene,
+    ray: &Ray,
+    surface: &SurfaceHit,
+    sampler: &mut Sampler,
+    mut term: impl FnMut(usize, &crate::light::LightSample, Rgb),
+) {
+    let wo = -ray.dir;
     let material = scene.material_at(surface);
     let key = sampler.next_key();
     scene.for_each_light_at(surface.p, |index, _| {
@@ -265,15 +294,9 @@ pub fn surface_radiance(
             return;
         }
         let f = material.brdf(surface.p, surface.n, wo, sample.wi);
-        if f == Rgb::ZERO || !scene.unoccluded(surface.p, Some(surface.n), &sample) {
+        if f == Rgb::ZERO {
             return;
         }
-        let mut contribution = f * sample.weight * cos;
-        if let Some(m) = medium {
-            let origin = crate::geometry::offset_origin(surface.p, surface.n, sample.wi);
-            contribution *= m.transmittance(origin, sample.wi, 0.0, scene.light_distance(sample.distance));
-        }
-        radiance += contribution;
+        term(index, &sample, f * sample.weight * cos);
     });
-    radiance
 }

@@ -18,30 +18,29 @@ pub const ASSET_PATH_VAR: &str = "AIRLIGHT_ASSET_PATH";
 /// Largest mesh file read.
 pub const MAX_MESH_BYTES: u64 = 1 << 30;
 
-/// The folders a scene may read files from, in the order searched.
+/// Where the names of a scene's files are looked up.
 #[derive(Clone, Debug, PartialEq, Eq)]
-pub struct AssetPath {
-    folders: Vec<PathBuf>,
-    /// A path typed on the command line: the user's own, so any file they
-    /// can read, absolute or relative to the working directory, not only
-    /// what lies inside the folders.
-    command_line: bool,
+pub enum AssetPath {
+    /// A scene file's names: inside these folders, in the order searched
+    /// (see the module documentation).
+    Folders(Vec<PathBuf>),
+    /// A path typed on the command line (`--medium type="grid",file=…`):
+    /// the user's own, so any regular file they can read, absolute or
+    /// relative to the working directory. The limits above guard against
+    /// scene authors, and the user who types the command is not one.
+    CommandLine,
 }
 
 impl AssetPath {
     /// The scene's folder (None or empty: the current one), then `extra`.
     pub fn new(scene_dir: Option<&Path>, extra: &[PathBuf]) -> Self {
         let scene_dir = scene_dir.filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
-        let folders = std::iter::once(scene_dir.to_path_buf()).chain(extra.iter().cloned()).collect();
-        AssetPath { folders, command_line: false }
+        AssetPath::Folders(std::iter::once(scene_dir.to_path_buf()).chain(extra.iter().cloned()).collect())
     }
 
-    /// The paths of a command-line option (`--medium type="grid",file=…`):
-    /// any regular file, absolute or relative to the working directory. The
-    /// limits above guard against scene authors, and the user who types the
-    /// command is not one.
+    /// The paths of a command-line option: see [`AssetPath::CommandLine`].
     pub fn command_line() -> Self {
-        AssetPath { folders: vec![PathBuf::from(".")], command_line: true }
+        AssetPath::CommandLine
     }
 
     /// The folders listed in `AIRLIGHT_ASSET_PATH`, if set.
@@ -51,28 +50,35 @@ impl AssetPath {
             .unwrap_or_default()
     }
 
+    /// The folders searched (none for a command-line path).
     pub fn folders(&self) -> &[PathBuf] {
-        &self.folders
+        match self {
+            AssetPath::Folders(folders) => folders,
+            AssetPath::CommandLine => &[],
+        }
     }
 
     /// The file `name` stands for, with symbolic links resolved; or why
     /// not (see the module documentation).
     pub fn resolve(&self, name: &str) -> Result<PathBuf, String> {
-        if self.command_line {
-            return match Path::new(name).canonicalize() {
-                Ok(found) if found.is_file() => Ok(found),
-                Ok(_) => Err(format!("`{name}` is not a file")),
-                Err(e) => Err(format!("cannot open `{name}` (relative to the working directory): {e}")),
-            };
-        }
+        let folders = match self {
+            AssetPath::Folders(folders) => folders,
+            AssetPath::CommandLine => {
+                return match Path::new(name).canonicalize() {
+                    Ok(found) if found.is_file() => Ok(found),
+                    Ok(_) => Err(format!("`{name}` is not a file")),
+                    Err(e) => Err(format!("cannot open `{name}` (relative to the working directory): {e}")),
+                };
+            }
+        };
         let relative = Path::new(name);
         let plain = !name.is_empty()
             && !name.contains('\0')
             && relative.components().all(|c| matches!(c, Component::Normal(_) | Component::CurDir));
         if !plain {
-            return Err(format!("`{name}` must be a relative path inside {}, without `..`", self.describe()));
+            return Err(format!("`{name}` must be a relative path inside {}, without `..`", describe(folders)));
         }
-        for folder in &self.folders {
+        for folder in folders {
             let (Ok(root), Ok(found)) = (folder.canonicalize(), folder.join(relative).canonicalize()) else {
                 continue;
             };
@@ -80,17 +86,21 @@ impl AssetPath {
                 return Ok(found);
             }
         }
-        Err(format!("no file `{name}` in {} (more folders: {ASSET_PATH_VAR})", self.describe()))
+        Err(format!("no file `{name}` in {} (more folders: {ASSET_PATH_VAR})", describe(folders)))
     }
+}
 
-    /// "the scene's folder `d`" or "the scene's folder `d` or the asset folders `a`, `b`".
-    fn describe(&self) -> String {
-        let quoted = |p: &PathBuf| format!("`{}`", p.display());
-        let first = format!("the scene's folder {}", quoted(&self.folders[0]));
-        match &self.folders[1..] {
-            [] => first,
-            rest => format!("{first} or the asset folders {}", rest.iter().map(quoted).collect::<Vec<_>>().join(", ")),
-        }
+/// "the scene's folder `d`" or "the scene's folder `d` or the asset folders
+/// `a`, `b`", for `folders` as [`AssetPath::new`] makes them.
+fn describe(folders: &[PathBuf]) -> String {
+    let quoted = |p: &PathBuf| format!("`{}`", p.display());
+    let Some((first, rest)) = folders.split_first() else {
+        return "no folder".into();
+    };
+    let first = format!("the scene's folder {}", quoted(first));
+    match rest {
+        [] => first,
+        rest => format!("{first} or the asset folders {}", rest.iter().map(quoted).collect::<Vec<_>>().join(", ")),
     }
 }
 

@@ -1,0 +1,41 @@
+//! Helpers shared by the tests that render small scenes in a medium with
+//! two integrators and compare them within noise.
+
+use airlight::film::Image;
+use airlight::integrator::Integrator;
+use airlight::prelude::*;
+use airlight::render::accumulate;
+
+/// A `size`² image of one light in `medium`, seen from `camera` with the
+/// medium scattering out to `max_distance`; every sample goes through its
+/// pixel's centre, so that integrators trace the same camera rays.
+pub fn fog_scene(
+    (size, seed, max_distance): (u32, u64, f32),
+    medium: Medium,
+    light: Light,
+    camera: Camera,
+    spp: u32,
+) -> Scene {
+    SceneBuilder::new()
+        .size(size, size)
+        .with_settings(|s| {
+            s.spp = spp;
+            s.seed = seed;
+            s.max_distance = max_distance;
+            s.filter = airlight::scene::PixelFilter::Point;
+        })
+        .camera(camera)
+        .light(light)
+        .medium(medium)
+        .build()
+        .unwrap()
+}
+
+/// `integrator`'s image of `scene` at its spp and the variance of each
+/// pixel's mean, from the pixels' mean squared samples (s²/n, s² the
+/// unbiased variance).
+pub fn image_and_variance(scene: &Scene, integrator: &dyn Integrator) -> (Image, Vec<Rgb>) {
+    let (spp, height) = (scene.settings().spp, scene.settings().height);
+    let sums = accumulate(scene, integrator, 0..spp as u64, 0..height, &RenderObserver::none());
+    (sums.image(), sums.variance().pixels)
+}
