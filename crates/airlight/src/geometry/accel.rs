@@ -6,6 +6,7 @@
 use super::Ray;
 use super::batch::{comes_before, test_bound};
 use super::bvh4::{self, BoxRay, Bvh4};
+use super::quad_lanes::QuadLanes;
 use super::sdf::{Sdf, sphere_trace};
 use super::shape::{Shape, box_normal, intersect_box, intersect_quad, intersect_sphere, intersect_triangle};
 use glam::{Affine3A, Mat3, Vec2, Vec3, Vec3A};
@@ -209,6 +210,10 @@ pub struct Geometry {
     pub(super) triangles: Vec<[Vec3; 3]>,
     /// None when there are few primitives: testing them all is faster.
     bvh: Option<Bvh4>,
+    /// A small scene of quads and a few other primitives: the quads in
+    /// SIMD lanes and the other records' indices, tested all at once for
+    /// single rays instead of through `bvh` (which packets still use).
+    small: Option<(QuadLanes, Vec<Other>)>,
     bounds: Option<(Vec3, Vec3)>,
     /// The texture coordinates of the triangles that have them.
     triangle_uvs: Vec<[Vec2; 3]>,
@@ -220,6 +225,11 @@ pub struct Geometry {
 /// the tree, with the same hits; the Cornell box (8) is 1.10× faster
 /// through it.
 const LINEAR_LIMIT: usize = 4;
+/// Up to this many primitives, at least half of them quads and none a
+/// signed distance field, single rays test the quads in SIMD lanes and the
+/// rest one by one rather than through the BVH (quad_lanes.rs): the Cornell box
+/// (six quads, two rotated boxes) renders faster so, with the same hits.
+const SMALL_LIMIT: usize = 16;
 /// Up to this many primitives, the BVH's leaves hold one primitive each.
 const SMALL_SCENE: usize = 64;
 
@@ -312,7 +322,7 @@ impl GeometryBuilder {
         let bounds = bounds.map(|b| (Vec3::from(b.min), Vec3::from(b.max)));
         if records.len() <= LINEAR_LIMIT {
             let triangles = triangles_of(&records);
-            return Geometry { records, planes, unbounded, triangles, bvh: None, bounds, triangle_uvs };
+            return Geometry { records, planes, unbounded, triangles, bvh: None, small: None, bounds, triangle_uvs };
         }
         let mut params = BvhBuildParams::medium_build();
         if records.len() <= SMALL_SCENE {
@@ -333,10 +343,62 @@ impl GeometryBuilder {
         // can make the tree deeper than the traversal's fixed stack: such
         // scenes are searched linearly instead, slow but right.
         if bvh.depth() > bvh4::MAX_DEPTH {
-            return Geometry { records, planes, unbounded, triangles, bvh: None, bounds, triangle_uvs };
+            return Geometry { records, planes, unbounded, triangles, bvh: None, small: None, bounds, triangle_uvs };
         }
-        Geometry { records, planes, unbounded, triangles, bvh: Some(bvh), bounds, triangle_uvs }
+        let small = small_scene(&records);
+        Geometry { records, planes, unbounded, triangles, bvh: Some(bvh), small, bounds, triangle_uvs }
     }
+}
+
+/// A small scene's record that is not a quad, with a sphere around it:
+/// a ray that misses the sphere misses the record, without the record's
+/// own test (a rotated box's transform of the ray costs more).
+#[derive(Clone, Copy, Debug)]
+struct Other {
+    index: u32,
+    center: Vec3,
+    radius_squared: f32,
+}
+
+impl Other {
+    /// Whether the ray `o + t·d`, t > 0, may meet the record: it passes
+    /// within the sphere, and the sphere is not wholly behind its origin.
+    #[inline]
+    fn may_hit(&self, o: Vec3, d: Vec3) -> bool {
+        let oc = self.center - o;
+        let b = oc.dot(d);
+        let oc2 = oc.length_squared();
+        let inside = oc2 <= self.radius_squared;
+        inside || (b > 0.0 && oc2 * d.length_squared() - b * b <= self.radius_squared * d.length_squared())
+    }
+}
+
+/// The quads in lanes and the other records, for a scene small enough
+/// ([`SMALL_LIMIT`]).
+fn small_scene(records: &[Record]) -> Option<(QuadLanes, Vec<Other>)> {
+    let quads: Vec<(u32, Vec3, Vec3, Vec3)> = records
+        .iter()
+        .enumerate()
+        .filter_map(|(i, r)| match r.prim {
+            Prim::Quad { corner, edge_u, edge_v } => Some((i as u32, corner, edge_u, edge_v)),
+            _ => None,
+        })
+        .collect();
+    let others: Vec<Other> = (0..records.len() as u32)
+        .filter(|&i| !matches!(records[i as usize].prim, Prim::Quad { .. }))
+        .map(|index| {
+            let b = records[index as usize].prim.bounds();
+            let (min, max) = (Vec3::from(b.min), Vec3::from(b.max));
+            // Generous: a sphere that only just holds the box could lose a
+            // grazing hit to rounding.
+            let radius = 0.5 * (max - min).length() * 1.001 + 1e-4 * (1.0 + min.abs().max(max.abs()).max_element());
+            Other { index, center: 0.5 * (min + max), radius_squared: radius * radius }
+        })
+        .collect();
+    let fits = records.len() <= SMALL_LIMIT
+        && quads.len() >= others.len()
+        && !records.iter().any(|r| matches!(r.prim, Prim::Sdf(_)));
+    fits.then(|| (QuadLanes::new(&quads), others))
 }
 
 /// The (v0, e1, e2) of every triangle record, zeros for other primitives.
@@ -365,30 +427,46 @@ impl Geometry {
     /// The nearest hit with 0 < t < tmax.
     pub fn intersect(&self, ray: &Ray, tmax: f32) -> Option<Hit> {
         let mut best = Hit { t: tmax, id: u32::MAX };
-        match &self.bvh {
-            Some(bvh) => {
-                let (o, d) = (ray.origin, ray.dir);
-                let box_ray = BoxRay::new(o.to_array(), d.to_array());
-                let found = bvh.closest(&box_ray, tmax, |first, count, mixed, (mut best_t, mut best_id)| {
-                    let mut found = None;
-                    for i in first..first + count {
-                        let t = self.intersect_one(i as usize, mixed, o, d, test_bound(best_t, best_id));
-                        if comes_before(t, i, best_t, best_id) {
-                            (best_t, best_id) = (t, i);
-                            found = Some((t, i));
-                        }
-                    }
-                    found
-                });
-                if let Some((t, id)) = found {
+        if let Some((quads, others)) = &self.small {
+            let (o, d) = (ray.origin, ray.dir);
+            quads.for_each_nearest(o, d, tmax, |t, id| {
+                if comes_before(t, id, best.t, best.id) {
                     best = Hit { t, id };
                 }
+            });
+            for other in others.iter().filter(|other| other.may_hit(o, d)) {
+                let i = other.index;
+                let t = self.records[i as usize].prim.intersect(o, d, 0.0, test_bound(best.t, best.id));
+                if comes_before(t, i, best.t, best.id) {
+                    best = Hit { t, id: i };
+                }
             }
-            None => {
-                for (i, rec) in self.records.iter().enumerate() {
-                    let t = rec.prim.intersect(ray.origin, ray.dir, 0.0, best.t);
-                    if t < best.t {
-                        best = Hit { t, id: i as u32 };
+        } else {
+            match &self.bvh {
+                Some(bvh) => {
+                    let (o, d) = (ray.origin, ray.dir);
+                    let box_ray = BoxRay::new(o.to_array(), d.to_array());
+                    let found = bvh.closest(&box_ray, tmax, |first, count, mixed, (mut best_t, mut best_id)| {
+                        let mut found = None;
+                        for i in first..first + count {
+                            let t = self.intersect_one(i as usize, mixed, o, d, test_bound(best_t, best_id));
+                            if comes_before(t, i, best_t, best_id) {
+                                (best_t, best_id) = (t, i);
+                                found = Some((t, i));
+                            }
+                        }
+                        found
+                    });
+                    if let Some((t, id)) = found {
+                        best = Hit { t, id };
+                    }
+                }
+                None => {
+                    for (i, rec) in self.records.iter().enumerate() {
+                        let t = rec.prim.intersect(ray.origin, ray.dir, 0.0, best.t);
+                        if t < best.t {
+                            best = Hit { t, id: i as u32 };
+                        }
                     }
                 }
             }
@@ -420,6 +498,13 @@ impl Geometry {
         count_shadow_rays(1);
         if self.occluded_unbounded(origin, dir, tmax) {
             return true;
+        }
+        if let Some((quads, others)) = &self.small {
+            return quads.any_hit(origin, dir, tmax)
+                || others.iter().any(|other| {
+                    other.may_hit(origin, dir)
+                        && self.records[other.index as usize].prim.intersect(origin, dir, 0.0, tmax) < tmax
+                });
         }
         match &self.bvh {
             Some(bvh) => self.occluded_bvh(bvh, origin, dir, tmax),

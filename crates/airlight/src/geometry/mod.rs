@@ -5,6 +5,7 @@ mod batch;
 mod bvh4;
 mod lanes;
 mod packet;
+mod quad_lanes;
 mod ray;
 pub mod sdf;
 mod shape;
