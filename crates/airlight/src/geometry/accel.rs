@@ -7,158 +7,14 @@ use super::Ray;
 use super::batch::{comes_before, test_bound};
 use super::bvh4::{self, BoxRay, Bvh4};
 use super::quad_lanes::QuadLanes;
-use super::sdf::{Sdf, sphere_trace};
-use super::shape::{Shape, box_normal, intersect_box, intersect_quad, intersect_sphere, intersect_triangle};
-use glam::{Affine3A, Mat3, Vec2, Vec3, Vec3A};
-use obvhs::{Boundable, BvhBuildParams, aabb::Aabb};
+use super::records::{
+    Instance, NO_UV, PlaneRecord, Prim, Record, SdfPrim, UNBOUNDED_FAR, UnboundedSdf, barycentric, intersect_plane,
+};
+use super::sdf::sphere_trace;
+use super::shape::{Shape, intersect_triangle};
+use glam::{Mat3, Vec2, Vec3, Vec3A};
+use obvhs::{BvhBuildParams, aabb::Aabb};
 use std::time::Duration;
-
-/// One primitive the BVH holds.
-#[derive(Clone, Debug)]
-enum Prim {
-    Sphere {
-        center: Vec3,
-        radius: f32,
-    },
-    Quad {
-        corner: Vec3,
-        edge_u: Vec3,
-        edge_v: Vec3,
-    },
-    Box {
-        min: Vec3,
-        max: Vec3,
-    },
-    Triangle {
-        v0: Vec3,
-        e1: Vec3,
-        e2: Vec3,
-    },
-    /// A sphere or box in its own space.
-    Instance(std::boxed::Box<Instance>),
-    /// A signed distance field, sphere traced inside its bounding box.
-    Sdf(std::boxed::Box<SdfPrim>),
-}
-
-#[derive(Clone, Debug)]
-struct SdfPrim {
-    sdf: Sdf,
-    min: Vec3,
-    max: Vec3,
-}
-
-#[derive(Clone, Debug)]
-struct Instance {
-    prim: Prim,
-    local_from_world: Affine3A,
-    /// Maps local normals to world normals: the inverse transpose of the
-    /// linear part of world_from_local.
-    normal_to_world: Mat3,
-    bounds: Aabb,
-}
-
-#[derive(Clone, Debug)]
-struct Record {
-    prim: Prim,
-    material: u32,
-    emitter: Option<u32>,
-    /// A triangle's texture coordinates: its index in `Geometry::triangle_uvs`,
-    /// or [`NO_UV`]. (The field fits in the record's padding: meshes
-    /// without texture coordinates cost nothing more.)
-    uv: u32,
-}
-
-/// A record without texture coordinates of its own.
-const NO_UV: u32 = u32::MAX;
-
-/// An SDF that no box bounds (it holds a plane): traced on its own.
-#[derive(Clone, Debug)]
-struct UnboundedSdf {
-    sdf: Sdf,
-    material: u32,
-}
-
-/// How far an unbounded SDF is traced when the ray has no end.
-const UNBOUNDED_FAR: f32 = 1e5;
-
-#[derive(Clone, Debug)]
-struct PlaneRecord {
-    point: Vec3,
-    normal: Vec3,
-    material: u32,
-}
-
-impl Prim {
-    #[inline]
-    fn intersect(&self, o: Vec3, d: Vec3, tmin: f32, tmax: f32) -> f32 {
-        match self {
-            Prim::Sphere { center, radius } => intersect_sphere(*center, *radius, o, d, tmin, tmax),
-            Prim::Quad { corner, edge_u, edge_v } => intersect_quad(*corner, *edge_u, *edge_v, o, d, tmin, tmax),
-            Prim::Box { min, max } => intersect_box(*min, *max, o, d, tmin, tmax),
-            Prim::Triangle { v0, e1, e2 } => intersect_triangle(*v0, *e1, *e2, o, d, tmin, tmax),
-            Prim::Instance(inst) => {
-                let lo = inst.local_from_world.transform_point3(o);
-                let ld = inst.local_from_world.transform_vector3(d);
-                inst.prim.intersect(lo, ld, tmin, tmax)
-            }
-            Prim::Sdf(s) => {
-                // Trace only where the ray is inside the bounding box.
-                let inv = d.recip();
-                let (ta, tb) = ((s.min - o) * inv, (s.max - o) * inv);
-                let near = ta.min(tb).max_element().max(tmin);
-                let far = ta.max(tb).min_element().min(tmax);
-                if near.is_nan() || far.is_nan() || near > far {
-                    return f32::INFINITY;
-                }
-                let t = sphere_trace(&s.sdf, o, d, near, far);
-                if t > tmin && t < tmax { t } else { f32::INFINITY }
-            }
-        }
-    }
-
-    /// The outward unit normal at a point `p` on the primitive.
-    fn normal(&self, p: Vec3) -> Vec3 {
-        match self {
-            Prim::Sphere { center, .. } => (p - *center).normalize(),
-            Prim::Quad { edge_u, edge_v, .. } => edge_u.cross(*edge_v).normalize(),
-            Prim::Box { min, max } => box_normal(*min, *max, p),
-            Prim::Triangle { e1, e2, .. } => e1.cross(*e2).normalize(),
-            Prim::Instance(inst) => {
-                let local = inst.prim.normal(inst.local_from_world.transform_point3(p));
-                (inst.normal_to_world * local).normalize()
-            }
-            Prim::Sdf(s) => s.sdf.normal(p),
-        }
-    }
-
-    fn bounds(&self) -> Aabb {
-        match self {
-            Prim::Sphere { center, radius } => {
-                Aabb::new(Vec3A::from(*center - *radius), Vec3A::from(*center + *radius))
-            }
-            Prim::Quad { corner, edge_u, edge_v } => Aabb::from_points(&[
-                (*corner).into(),
-                (*corner + *edge_u).into(),
-                (*corner + *edge_v).into(),
-                (*corner + *edge_u + *edge_v).into(),
-            ]),
-            Prim::Box { min, max } => Aabb::new((*min).into(), (*max).into()),
-            Prim::Triangle { v0, e1, e2 } => Aabb::from_points(&[(*v0).into(), (*v0 + *e1).into(), (*v0 + *e2).into()]),
-            Prim::Instance(inst) => inst.bounds,
-            Prim::Sdf(s) => Aabb::new(s.min.into(), s.max.into()),
-        }
-    }
-}
-
-impl Boundable for Record {
-    fn aabb(&self) -> Aabb {
-        // Pad every box: a quad or triangle lying in an axis plane has a flat
-        // box, which a ray along that plane's normal would pass as empty.
-        let b = self.prim.bounds();
-        let pad = 1e-5 * (1.0 + b.min.abs().max(b.max.abs()).max_element());
-        Aabb::new(b.min - pad, b.max + pad)
-    }
-}
 
 thread_local! {
     /// Shadow rays traced by this thread, for benchmarks (a thread-local
@@ -222,8 +78,8 @@ pub struct Geometry {
 /// Up to this many primitives are tested one by one, without the BVH: the
 /// fog comparison scenes (3 and 4 primitives, one a sphere enclosing the
 /// rest, whose box no ray misses) render 8% and 4% faster so than through
-/// the tree, with the same hits; the Cornell box (8) is 1.10× faster
-/// through it.
+/// the tree, with the same hits. Larger scenes take the quads' lanes
+/// ([`SMALL_LIMIT`]) or the tree.
 const LINEAR_LIMIT: usize = 4;
 /// Up to this many primitives, at least half of them quads and none a
 /// signed distance field, single rays test the quads in SIMD lanes and the
@@ -612,26 +468,4 @@ impl Geometry {
             _ => None,
         }
     }
-}
-
-/// The coordinates (a, b) of `rel = a·e1 + b·e2` for a point in the plane
-/// of `e1` and `e2`, by least squares (the 2×2 normal equations).
-#[inline]
-fn barycentric(rel: Vec3, e1: Vec3, e2: Vec3) -> [f32; 2] {
-    let (d11, d12, d22) = (e1.dot(e1), e1.dot(e2), e2.dot(e2));
-    let (r1, r2) = (rel.dot(e1), rel.dot(e2));
-    let det = d11 * d22 - d12 * d12;
-    if det == 0.0 {
-        return [0.0, 0.0];
-    }
-    [(d22 * r1 - d12 * r2) / det, (d11 * r2 - d12 * r1) / det]
-}
-
-#[inline]
-fn intersect_plane(plane: &PlaneRecord, o: Vec3, d: Vec3) -> f32 {
-    let denom = plane.normal.dot(d);
-    if denom.abs() < 1e-20 {
-        return f32::INFINITY;
-    }
-    plane.normal.dot(plane.point - o) / denom
 }

@@ -7,6 +7,7 @@ mod lanes;
 mod packet;
 mod quad_lanes;
 mod ray;
+mod records;
 pub mod sdf;
 mod shape;
 
