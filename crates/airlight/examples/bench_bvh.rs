@@ -16,7 +16,7 @@
 //! and shading; the scene of `tools/mesh_scene.py`) on all threads, with
 //! samples handed over in blocks (packets) and one by one.
 
-use airlight::geometry::{GeometryBuilder, Ray, Segment, Shape, intersect_triangle, offset_origin};
+use airlight::geometry::{Geometry, GeometryBuilder, Hit, Ray, Segment, Shape, intersect_triangle, offset_origin};
 use airlight::integrator::{Direct, Integrator};
 use airlight::prelude::*;
 use glam::Vec2;
@@ -100,30 +100,30 @@ fn main() {
     let primary = |rays: &[Ray]| rays.iter().map(|ray| geometry.intersect(ray, f32::INFINITY).is_some() as u64).sum();
     let occluded =
         |segments: &[Segment]| segments.iter().map(|s| geometry.occluded(s.origin, s.dir, s.tmax) as u64).sum();
-    let primary_packet = |rays: &[Ray]| {
-        let mut hits = [None; CHUNK];
-        let hits = &mut hits[..rays.len()];
-        geometry.intersect_packet(rays, f32::INFINITY, hits);
-        hits.iter().filter(|h| h.is_some()).count() as u64
+    // A packet query as a count of hits, for either lane width.
+    type Intersect = fn(&Geometry, &[Ray], f32, &mut [Option<Hit>]);
+    type Occluded = fn(&Geometry, &[Segment], &mut [bool]);
+    let geometry = &geometry;
+    let primary_with = |query: Intersect| {
+        move |rays: &[Ray]| {
+            let mut hits = [None; CHUNK];
+            let hits = &mut hits[..rays.len()];
+            query(geometry, rays, f32::INFINITY, hits);
+            hits.iter().filter(|h| h.is_some()).count() as u64
+        }
     };
-    let occluded_packet = |segments: &[Segment]| {
-        let mut blocked = [false; CHUNK];
-        let blocked = &mut blocked[..segments.len()];
-        geometry.occluded_packet(segments, blocked);
-        blocked.iter().filter(|&&b| b).count() as u64
+    let occluded_with = |query: Occluded| {
+        move |segments: &[Segment]| {
+            let mut blocked = [false; CHUNK];
+            let blocked = &mut blocked[..segments.len()];
+            query(geometry, segments, blocked);
+            blocked.iter().filter(|&&b| b).count() as u64
+        }
     };
-    let primary_packet4 = |rays: &[Ray]| {
-        let mut hits = [None; CHUNK];
-        let hits = &mut hits[..rays.len()];
-        geometry.intersect_packet_four_lanes(rays, f32::INFINITY, hits);
-        hits.iter().filter(|h| h.is_some()).count() as u64
-    };
-    let occluded_packet4 = |segments: &[Segment]| {
-        let mut blocked = [false; CHUNK];
-        let blocked = &mut blocked[..segments.len()];
-        geometry.occluded_packet_four_lanes(segments, blocked);
-        blocked.iter().filter(|&&b| b).count() as u64
-    };
+    let primary_packet = primary_with(Geometry::intersect_packet);
+    let occluded_packet = occluded_with(Geometry::occluded_packet);
+    let primary_packet4 = primary_with(Geometry::intersect_packet_four_lanes);
+    let occluded_packet4 = occluded_with(Geometry::occluded_packet_four_lanes);
     let pp = time(&rays, primary_packet);
     let sp = time(&shadow, occluded_packet);
     let pp4 = time(&rays, primary_packet4);

@@ -38,11 +38,6 @@ impl AssetPath {
         AssetPath::Folders(std::iter::once(scene_dir.to_path_buf()).chain(extra.iter().cloned()).collect())
     }
 
-    /// The paths of a command-line option: see [`AssetPath::CommandLine`].
-    pub fn command_line() -> Self {
-        AssetPath::CommandLine
-    }
-
     /// The folders listed in `AIRLIGHT_ASSET_PATH`, if set.
     pub fn from_env() -> Vec<PathBuf> {
         std::env::var_os(ASSET_PATH_VAR)
@@ -171,7 +166,7 @@ mod tests {
         let root = tempfile::tempdir().unwrap();
         let file = root.path().join("cloud.vol");
         std::fs::write(&file, "").unwrap();
-        let path = AssetPath::command_line();
+        let path = AssetPath::CommandLine;
         let name = file.to_str().unwrap();
         assert_eq!(path.resolve(name).unwrap(), file.canonicalize().unwrap());
         // Cargo runs a test in its package's folder.

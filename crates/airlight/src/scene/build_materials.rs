@@ -19,13 +19,13 @@ use toml::Spanned;
 /// checked by the same rules as the table. For command lines, which give
 /// a medium without a scene file; a message without a line number. A
 /// grid's `file` is any file the user can read, absolute or relative to
-/// the working directory ([`AssetPath::command_line`]).
+/// the working directory ([`AssetPath::CommandLine`]).
 pub fn medium_from_options(options: &str) -> Result<Medium, String> {
     let text = format!("medium = {{ {options} }}");
     let strip = |e: SceneError| e.message;
     let desc: SceneDesc = parse(&text).map_err(strip)?;
     let Some(medium) = &desc.medium else { return Err("no medium".into()) };
-    let assets = AssetPath::command_line();
+    let assets = AssetPath::CommandLine;
     let checker = Checker {
         text: &text,
         assets: &assets,
