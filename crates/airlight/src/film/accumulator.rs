@@ -17,6 +17,7 @@
 use crate::Rgb;
 use crate::film::Image;
 use glam::DVec3;
+use rayon::prelude::*;
 
 /// Fraction bits of a sample in [`PixelSum::sum`].
 pub const SUM_FRACTION_BITS: i32 = 48;
@@ -25,6 +26,7 @@ pub const SQUARE_FRACTION_BITS: i32 = 64;
 
 /// One pixel's samples: fixed-point sums per channel and how many.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+#[repr(C)]
 pub struct PixelSum {
     /// Σ x · 2⁴⁸, each term rounded to an integer.
     pub sum: [i128; 3],
@@ -57,9 +59,26 @@ fn to_fixed(x: f64, bits: i32) -> i128 {
     y.round() as i128
 }
 
+/// `x · 2^-bits` rounded to the nearest f64. A sum that fits in an `i64`
+/// takes the hardware conversion, which rounds exactly as the software
+/// i128 → f64 conversion does (to nearest, ties to even), at a fraction of
+/// its cost: it was a third of turning a 1024² film into an image.
 #[inline]
 fn from_fixed(x: i128, bits: i32) -> f64 {
-    x as f64 * 2f64.powi(-bits)
+    let whole = match i64::try_from(x) {
+        Ok(small) => small as f64,
+        Err(_) => wide_to_f64(x),
+    };
+    whole * 2f64.powi(-bits)
+}
+
+/// The software conversion, kept out of line: inlined, the compiler sees
+/// that both branches of [`from_fixed`] give the same value and keeps only
+/// this one.
+#[cold]
+#[inline(never)]
+fn wide_to_f64(x: i128) -> f64 {
+    x as f64
 }
 
 impl PixelSum {
@@ -119,6 +138,10 @@ impl PixelSum {
     }
 }
 
+// SAFETY: every field is an integer (or an array of them), for which all
+// zero bits are the value 0: a zeroed `PixelSum` is `PixelSum::default()`.
+unsafe impl bytemuck::Zeroable for PixelSum {}
+
 /// The samples of a band of rows of an image (all rows by default): a
 /// [`PixelSum`] per pixel, in rows of the full image's width.
 #[derive(Clone, Debug, PartialEq)]
@@ -144,7 +167,12 @@ impl Accumulator {
     pub fn band(width: u32, height: u32, rows: std::ops::Range<u32>) -> Self {
         let first_row = rows.start.min(height);
         let end = rows.end.clamp(first_row, height);
-        let pixels = vec![PixelSum::default(); width as usize * (end - first_row) as usize];
+        // Zeroed memory straight from the allocator (fresh pages for a large
+        // film), not `vec![PixelSum::default(); n]`, which writes every
+        // byte on this one thread first: 75 ms for a 1024² film, a fifth
+        // of rendering it at one sample per pixel. The pages are now zeroed
+        // as the render threads first touch them.
+        let pixels = bytemuck::zeroed_vec(width as usize * (end - first_row) as usize);
         Accumulator { width, height, first_row, pixels }
     }
 
@@ -198,9 +226,7 @@ impl Accumulator {
             return Err(format!("rows {theirs:?} do not lie within rows {mine:?}"));
         }
         let offset = ((theirs.start - mine.start) * self.width) as usize;
-        for (a, b) in self.pixels[offset..].iter_mut().zip(&other.pixels) {
-            a.merge(b);
-        }
+        self.pixels[offset..].par_iter_mut().zip(&other.pixels).for_each(|(a, b)| a.merge(b));
         Ok(())
     }
 
@@ -222,13 +248,15 @@ impl Accumulator {
         self.map(|p| p.variance_of_mean().as_vec3())
     }
 
-    fn map(&self, f: impl Fn(&PixelSum) -> Rgb) -> Image {
-        let mut image = Image::new(self.width, self.height);
+    /// `f` of every pixel held, black elsewhere; on all threads, each pixel
+    /// written once.
+    fn map(&self, f: impl Fn(&PixelSum) -> Rgb + Sync) -> Image {
         let start = (self.first_row * self.width) as usize;
-        for (out, p) in image.pixels[start..].iter_mut().zip(&self.pixels) {
-            *out = f(p);
-        }
-        image
+        let pixels = (0..self.width as usize * self.height as usize)
+            .into_par_iter()
+            .map(|i| i.checked_sub(start).and_then(|held| self.pixels.get(held)).map_or(Rgb::ZERO, &f))
+            .collect();
+        Image { width: self.width, height: self.height, pixels }
     }
 
     /// The estimated relative error of the image: √(Σ Var(mean) / Σ mean²)
@@ -260,6 +288,29 @@ mod tests {
                 Rgb::new(u * 2f32.powi(octave), u, 1.0 - u)
             })
             .collect()
+    }
+
+    #[test]
+    fn sums_that_fit_in_64_bits_convert_as_the_128_bit_conversion_does() {
+        let wide = |x: i128| std::hint::black_box(x) as f64;
+        let edges = [i64::MAX as i128, i64::MIN as i128, (1i128 << 53) + 1, -(1i128 << 60) - 3, (1 << 62) + 7];
+        let beyond = [i64::MAX as i128 + 1, i64::MIN as i128 - 1, (3i128 << 70) + 1, i128::MAX, i128::MIN];
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        let random = (0..1000).map(|_| {
+            state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            (state as i64 as i128) >> (state % 64)
+        });
+        for x in edges.into_iter().chain(beyond).chain(random).chain([0, 1, -1]) {
+            assert_eq!(from_fixed(x, 0).to_bits(), wide(x).to_bits(), "{x}");
+            assert_eq!(from_fixed(x, SUM_FRACTION_BITS).to_bits(), (wide(x) * 2f64.powi(-48)).to_bits(), "{x}");
+        }
+    }
+
+    #[test]
+    fn a_new_accumulator_is_all_empty_pixel_sums() {
+        let acc = Accumulator::band(7, 9, 2..5);
+        assert_eq!(acc.pixels().len(), 21);
+        assert!(acc.pixels().iter().all(|p| *p == PixelSum::default()));
     }
 
     #[test]
