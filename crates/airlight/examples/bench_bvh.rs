@@ -15,6 +15,10 @@
 //! render of that image with the direct integrator (camera ray, shadow ray
 //! and shading; the scene of `tools/mesh_scene.py`) on all threads, with
 //! samples handed over in blocks (packets) and one by one.
+//!
+//! Each ray throughput is the median of 7 timed passes (with the range of
+//! the one-thread passes): on a shared machine one pass of about 0.1 s can
+//! be a third off.
 
 use airlight::geometry::{Geometry, GeometryBuilder, Hit, Ray, Segment, Shape, intersect_triangle, offset_origin};
 use airlight::integrator::{Direct, Integrator};
@@ -225,12 +229,14 @@ fn cpu_seconds(clock: libc::clockid_t) -> f64 {
     ts.tv_sec as f64 + ts.tv_nsec as f64 * 1e-9
 }
 
-/// A timed run: wall seconds on one thread, that thread's CPU seconds, wall
-/// seconds on all threads, the process's CPU seconds for it, the summed
-/// result and the number of rays.
+/// Timed runs: wall seconds on one thread, that thread's CPU seconds, wall
+/// seconds on all threads, the process's CPU seconds for it (each the
+/// median of [`PASSES`] passes), the summed result and the number of rays.
 struct Timing {
     one: f64,
     one_cpu: f64,
+    /// The fastest and slowest pass's CPU seconds on one thread.
+    one_cpu_range: (f64, f64),
     all: f64,
     all_cpu: f64,
     sum: u64,
@@ -240,28 +246,64 @@ struct Timing {
 /// Rays handed over per call (and per parallel task).
 const CHUNK: usize = 256;
 
+/// Passes timed, each way: one pass over a million rays on one thread
+/// takes about 0.1 s, short enough for another process's burst to move a
+/// single figure by a third; the median of several holds still.
+const PASSES: usize = 7;
+
 /// Times `f` over `items` in chunks of [`CHUNK`], summing what it returns.
 fn time<T: Sync>(items: &[T], f: impl Fn(&[T]) -> u64 + Sync) -> Timing {
     let warm: u64 = items[..items.len().min(100_000)].chunks(CHUNK).map(&f).sum();
     std::hint::black_box(warm);
-    let (t, c) = (Instant::now(), cpu_seconds(libc::CLOCK_THREAD_CPUTIME_ID));
-    let sum: u64 = items.chunks(CHUNK).map(&f).sum();
-    let (one, one_cpu) = (t.elapsed().as_secs_f64(), cpu_seconds(libc::CLOCK_THREAD_CPUTIME_ID) - c);
-    let (t, c) = (Instant::now(), cpu_seconds(libc::CLOCK_PROCESS_CPUTIME_ID));
-    let all_sum: u64 = items.par_chunks(CHUNK).map(&f).sum();
-    let (all, all_cpu) = (t.elapsed().as_secs_f64(), cpu_seconds(libc::CLOCK_PROCESS_CPUTIME_ID) - c);
-    assert_eq!(sum, all_sum);
-    Timing { one, one_cpu, all, all_cpu, sum, n: items.len() }
+    let (mut one, mut one_cpu, mut all, mut all_cpu) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    let mut sum = 0;
+    for _ in 0..PASSES {
+        let (t, c) = (Instant::now(), cpu_seconds(libc::CLOCK_THREAD_CPUTIME_ID));
+        sum = items.chunks(CHUNK).map(&f).sum();
+        one.push(t.elapsed().as_secs_f64());
+        one_cpu.push(cpu_seconds(libc::CLOCK_THREAD_CPUTIME_ID) - c);
+        let (t, c) = (Instant::now(), cpu_seconds(libc::CLOCK_PROCESS_CPUTIME_ID));
+        let all_sum: u64 = items.par_chunks(CHUNK).map(&f).sum();
+        all.push(t.elapsed().as_secs_f64());
+        all_cpu.push(cpu_seconds(libc::CLOCK_PROCESS_CPUTIME_ID) - c);
+        assert_eq!(sum, all_sum);
+    }
+    let one_cpu_range = (min(&one_cpu), max(&one_cpu));
+    Timing {
+        one: median(one),
+        one_cpu: median(one_cpu),
+        one_cpu_range,
+        all: median(all),
+        all_cpu: median(all_cpu),
+        sum,
+        n: items.len(),
+    }
+}
+
+fn median(mut seconds: Vec<f64>) -> f64 {
+    seconds.sort_by(f64::total_cmp);
+    seconds[seconds.len() / 2]
+}
+
+fn min(seconds: &[f64]) -> f64 {
+    seconds.iter().copied().fold(f64::INFINITY, f64::min)
+}
+
+fn max(seconds: &[f64]) -> f64 {
+    seconds.iter().copied().fold(0.0, f64::max)
 }
 
 fn report(name: &str, primary: &Timing, shadow: &Timing, threads: usize) {
-    println!("{name}:");
+    println!("{name} (medians of {PASSES} passes):");
     for (kind, t) in [("primary", primary), ("shadow", shadow)] {
         let m = t.n as f64 / 1e6;
+        let (fastest, slowest) = t.one_cpu_range;
         println!(
-            "  {kind:7} 1 thread: {:6.2} M rays/s ({:6.2} per CPU s)   {threads} threads: {:6.2} M rays/s ({:6.2} per CPU s)",
+            "  {kind:7} 1 thread: {:6.2} M rays/s ({:6.2} per CPU s, passes {:.2}-{:.2})   {threads} threads: {:6.2} M rays/s ({:6.2} per CPU s)",
             m / t.one,
             m / t.one_cpu,
+            m / slowest,
+            m / fastest,
             m / t.all,
             m / t.all_cpu
         );
