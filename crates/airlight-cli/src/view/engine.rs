@@ -3,12 +3,13 @@
 //! solution when the lights moved, and renders more samples into a running
 //! mean, starting over whenever anything changed.
 
-use airlight::film::{Accumulator, Image};
+use airlight::film::{Accumulator, Image, PixelSum};
 use airlight::integrator::{Integrator, IntegratorDesc, IntegratorKind};
 use airlight::preview::{FirstSample, Preview};
 use airlight::radiosity::Radiosity;
 use airlight::render::{RenderObserver, accumulate};
 use airlight::{Camera, Scene, SceneFile, light::Light};
+use rayon::prelude::*;
 use std::time::{Duration, Instant};
 
 /// The integrators the number keys pick.
@@ -98,9 +99,7 @@ enum Samples {
 /// The sums of a one-sample image, as the renderer's accumulator holds them.
 fn sums_of(image: &Image) -> Accumulator {
     let mut sums = Accumulator::new(image.width, image.height);
-    for (sum, p) in sums.pixels_mut().iter_mut().zip(&image.pixels) {
-        sum.add(*p);
-    }
+    sums.pixels_mut().par_iter_mut().zip(&image.pixels).for_each(|(sum, &p)| sum.add(p));
     sums
 }
 
@@ -280,7 +279,10 @@ impl Engine {
     pub fn image(&self) -> Image {
         match &self.accumulator {
             Samples::None => Image::new(self.size().0, self.size().1),
-            Samples::First(image) => sums_of(image).image(),
+            // Each pixel as the accumulator would give it, without making one.
+            Samples::First(image) => {
+                Image { pixels: image.pixels.par_iter().map(|&p| PixelSum::of_one(p).mean()).collect(), ..*image }
+            }
             Samples::Sums(sums) => sums.image(),
         }
     }

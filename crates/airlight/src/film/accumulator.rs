@@ -98,6 +98,13 @@ impl PixelSum {
         }
     }
 
+    /// The sum of a single sample.
+    pub fn of_one(sample: Rgb) -> PixelSum {
+        let mut sum = PixelSum::default();
+        sum.add(sample);
+        sum
+    }
+
     /// Adds another pixel's samples (exact, in any order).
     #[inline]
     pub fn merge(&mut self, other: &PixelSum) {

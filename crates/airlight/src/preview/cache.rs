@@ -93,6 +93,7 @@ impl FirstSample {
         }
         self.weights.resize_with(h, Vec::new);
         let objects = &self.objects;
+        let camera = scene.camera().rays(s.width, s.height);
         self.texels.par_chunks_mut(w.max(1)).zip(self.weights.par_iter_mut()).enumerate().for_each(
             |(y, (texels, weights))| {
                 weights.clear();
@@ -104,7 +105,7 @@ impl FirstSample {
                             PixelFilter::Box => jitter,
                             PixelFilter::Point => Vec2::splat(0.5),
                         };
-                    let ray = scene.camera().ray(film, s.width, s.height, lens);
+                    let ray = camera.ray(film, lens);
                     let t = f32::INFINITY;
                     *texel = Texel { ray, hit: None, t, albedo: Rgb::ZERO, start: 0, len: 0, scale: 0.0 };
                     if let Some(hit) = objects.intersect(&ray, t) {
