@@ -26,7 +26,6 @@ pub const SQUARE_FRACTION_BITS: i32 = 64;
 
 /// One pixel's samples: fixed-point sums per channel and how many.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
-#[repr(C)]
 pub struct PixelSum {
     /// Σ x · 2⁴⁸, each term rounded to an integer.
     pub sum: [i128; 3],
