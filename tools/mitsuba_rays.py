@@ -69,8 +69,8 @@ def primary_rays():
 
 
 def timed(passes, run):
-    """Median seconds of `passes` calls of `run` after one warm-up call,
-    and the warm-up's result."""
+    """Median, fastest and slowest seconds of `passes` calls of `run` after
+    one warm-up call, and the warm-up's result."""
     result = run()
     seconds = []
     for _ in range(passes):
@@ -90,7 +90,7 @@ def airlight_figures(bench):
         if words and words[0] in ("primary", "shadow") and words[0] not in figures:
             # "primary 1 thread: A M rays/s (B per CPU s, passes C-D)   T threads: E M rays/s (F per CPU s)"
             figures[words[0]] = float(line.split("threads:")[1].split()[0])
-    return figures, out
+    return figures
 
 
 def main():
@@ -158,7 +158,7 @@ def main():
         return
     if not os.path.exists(args.bench):
         raise SystemExit(f"no bench_bvh at {args.bench}: cargo build --release -p airlight --example bench_bvh")
-    figures, _ = airlight_figures(args.bench)
+    figures = airlight_figures(args.bench)
     print("Airlight packets (bench_bvh, all threads, medians of its passes):")
     for kind, mitsuba in (("primary", n / t_primary / 1e6), ("shadow", m / t_shadow / 1e6)):
         print(f"  {kind:7} {figures[kind]:6.2f} M rays/s: {figures[kind] / mitsuba:.2f}x Mitsuba's")
