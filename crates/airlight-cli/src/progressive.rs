@@ -87,12 +87,19 @@ pub(crate) fn render_progressive(
             format_error(error),
         ));
         timing.writing(|| {
-            let variance = outputs.layers.wants_variance().then(|| progressive.variance());
-            write_images(scene, &progressive.image(), outputs, variance.as_ref())?;
-            // The variance is known from the second sample on (EXR: linear,
-            // the tone map is not applied).
-            if let Some(path) = outputs.variance.as_ref().filter(|_| progressive.samples() >= 2) {
-                progressive.variance().save(path).map_err(|e| format!("cannot write `{}`: {e}", path.display()))?;
+            // The variance is known from the second sample on; made once for
+            // the image's layers and the --variance file (EXR: linear, the
+            // tone map is not applied).
+            let variance_file = outputs.variance.as_ref().filter(|_| progressive.samples() >= 2);
+            let variance = (outputs.layers.wants_variance() || variance_file.is_some()).then(|| progressive.variance());
+            write_images(
+                scene,
+                &progressive.image(),
+                outputs,
+                variance.as_ref().filter(|_| outputs.layers.wants_variance()),
+            )?;
+            if let (Some(path), Some(variance)) = (variance_file, &variance) {
+                variance.save(path).map_err(|e| format!("cannot write `{}`: {e}", path.display()))?;
             }
             let header = PartialHeader { samples: 0..progressive.samples() as u64, ..state.header.clone() };
             Partial { header, sums: progressive.accumulator().clone() }

@@ -65,9 +65,9 @@ fn to_fixed(x: f64, bits: i32) -> i128 {
 }
 
 /// `x · 2^-bits` rounded to the nearest f64. A sum that fits in an `i64`
-/// takes the hardware conversion, which rounds exactly as the software
-/// i128 → f64 conversion does (to nearest, ties to even), at a fraction of
-/// its cost: it was a third of turning a 1024² film into an image.
+/// takes the hardware conversion (one instruction), which rounds exactly
+/// as the i128 → f64 conversion (a library call, `__floattidf`) does: to
+/// nearest, ties to even.
 #[inline]
 fn from_fixed(x: i128, bits: i32) -> f64 {
     let whole = match i64::try_from(x) {

@@ -232,6 +232,16 @@ impl Other {
 /// The quads in lanes and the other records, for a scene small enough
 /// ([`SMALL_LIMIT`]).
 fn small_scene(records: &[Record]) -> Option<(QuadLanes, Vec<Other>)> {
+    // Decided before anything is collected: a mesh's million records
+    // would otherwise each get a bounding sphere only to be dropped.
+    let is_quad = |r: &Record| matches!(r.prim, Prim::Quad { .. });
+    let quad_count = records.iter().filter(|r| is_quad(r)).count();
+    let fits = records.len() <= SMALL_LIMIT
+        && 2 * quad_count >= records.len()
+        && !records.iter().any(|r| matches!(r.prim, Prim::Sdf(_)));
+    if !fits {
+        return None;
+    }
     let quads: Vec<(u32, Vec3, Vec3, Vec3)> = records
         .iter()
         .enumerate()
@@ -241,7 +251,7 @@ fn small_scene(records: &[Record]) -> Option<(QuadLanes, Vec<Other>)> {
         })
         .collect();
     let others: Vec<Other> = (0..records.len() as u32)
-        .filter(|&i| !matches!(records[i as usize].prim, Prim::Quad { .. }))
+        .filter(|&i| !is_quad(&records[i as usize]))
         .map(|index| {
             let b = records[index as usize].prim.bounds();
             let (min, max) = (Vec3::from(b.min), Vec3::from(b.max));
@@ -251,10 +261,7 @@ fn small_scene(records: &[Record]) -> Option<(QuadLanes, Vec<Other>)> {
             Other { index, center: 0.5 * (min + max), radius_squared: radius * radius }
         })
         .collect();
-    let fits = records.len() <= SMALL_LIMIT
-        && quads.len() >= others.len()
-        && !records.iter().any(|r| matches!(r.prim, Prim::Sdf(_)));
-    fits.then(|| (QuadLanes::new(&quads), others))
+    Some((QuadLanes::new(&quads), others))
 }
 
 /// The (v0, e1, e2) of every triangle record, zeros for other primitives.
