@@ -5,7 +5,7 @@
 
 use airlight::film::{Accumulator, Image, PixelSum};
 use airlight::integrator::{Integrator, IntegratorDesc, IntegratorKind};
-use airlight::preview::{FirstSample, Preview};
+use airlight::preview::{Fill, FirstSample, Preview};
 use airlight::radiosity::Radiosity;
 use airlight::render::{RenderObserver, accumulate};
 use airlight::{Camera, Scene, SceneFile, light::Light};
@@ -82,6 +82,8 @@ pub struct Engine {
     accumulator: Samples,
     samples: u32,
     lights_dirty: bool,
+    /// Whether the camera moved since the last frame.
+    camera_moved: bool,
     /// The preview's first sample, kept while the camera stands still.
     first: FirstSample,
 }
@@ -89,10 +91,12 @@ pub struct Engine {
 /// The samples of the running mean. A frame with a single sample per
 /// pixel, all a moving camera ever gets, is kept as rendered: its per-pixel
 /// sums (about 100 bytes a pixel, 24 MB at 640×360) would be made, zeroed
-/// and thrown away at every frame.
+/// and thrown away at every frame. A moving camera's is made with the
+/// preview's sparse lookups ([`Fill::Sparse`]), and made again exactly
+/// when the camera stops, before samples are added to it.
 enum Samples {
     None,
-    First(Image),
+    First(Image, Fill),
     Sums(Accumulator),
 }
 
@@ -128,6 +132,7 @@ impl Engine {
             accumulator: Samples::None,
             samples: 0,
             lights_dirty: false,
+            camera_moved: false,
         }
     }
 
@@ -168,6 +173,7 @@ impl Engine {
     pub fn set_camera(&mut self, camera: Camera) {
         if camera != *self.scene.camera() {
             self.scene.set_camera(camera);
+            self.camera_moved = true;
             self.restart();
         }
     }
@@ -197,10 +203,16 @@ impl Engine {
     /// One frame: relight if the lights moved (the preview needs it; the
     /// other integrators relight on their own), then add samples: one after
     /// a change, then doubling up to `batch` per frame, until `max_spp`.
-    /// The samples are numbered across frames, so the running mean is the
-    /// same image as one render of that many samples.
+    /// The samples are numbered across frames, so once the camera stands
+    /// still the running mean is the same image as one render of that many
+    /// samples (a moving camera's frames interpolate the indirect light).
     pub fn frame(&mut self) -> FrameStats {
         let mut stats = FrameStats::default();
+        let moving = std::mem::take(&mut self.camera_moved);
+        if !moving && matches!(self.accumulator, Samples::First(_, Fill::Sparse)) {
+            // The camera stopped: its first sample again, exactly.
+            self.restart();
+        }
         if self.lights_dirty
             && self.mode == Mode::Preview
             && let Some(solution) = &mut self.solution
@@ -223,9 +235,12 @@ impl Engine {
                     );
                     if self.samples == 0 && count == 1 {
                         // The same samples as rendering sample 0, from hits
-                        // kept while the camera stands still.
-                        let image = self.first.render(&self.scene, self.solution.as_ref(), &preview);
-                        self.accumulator = Samples::First(image);
+                        // kept while the camera stands still; while it
+                        // moves, with the indirect light interpolated.
+                        let fill =
+                            if moving && std::env::var_os("EXACT").is_none() { Fill::Sparse } else { Fill::Exact };
+                        let image = self.first.render(&self.scene, self.solution.as_ref(), &preview, fill);
+                        self.accumulator = Samples::First(image, fill);
                         self.samples = 1;
                         stats.image = t.elapsed();
                         stats.added = 1;
@@ -248,7 +263,7 @@ impl Engine {
             };
             let mut sums = match std::mem::replace(&mut self.accumulator, Samples::None) {
                 Samples::Sums(sums) => sums,
-                Samples::First(image) => sums_of(&image),
+                Samples::First(image, _) => sums_of(&image),
                 Samples::None => Accumulator::new(0, 0),
             };
             // A size change (or no samples yet) starts from this pass alone.
@@ -280,7 +295,7 @@ impl Engine {
         match &self.accumulator {
             Samples::None => Image::new(self.size().0, self.size().1),
             // Each pixel as the accumulator would give it, without making one.
-            Samples::First(image) => {
+            Samples::First(image, _) => {
                 Image { pixels: image.pixels.par_iter().map(|&p| PixelSum::of_one(p).mean()).collect(), ..*image }
             }
             Samples::Sums(sums) => sums.image(),
@@ -339,9 +354,37 @@ mod tests {
         (s.width, s.height, s.spp) = (32, 18, 1);
         let mut e = engine();
         e.frame();
-        assert!(matches!(e.accumulator, Samples::First(_)));
+        assert!(matches!(e.accumulator, Samples::First(_, Fill::Exact)));
         let once = airlight::render(&scene, &e.preview(), &RenderObserver::none());
         assert_eq!(e.image(), once);
+        e.frame();
+        scene.settings_mut().spp = 2;
+        assert_eq!(e.image(), airlight::render(&scene, &e.preview(), &RenderObserver::none()));
+    }
+
+    #[test]
+    fn a_moving_camera_interpolates_and_a_stopped_one_renders_its_first_sample_again_exactly() {
+        let mut e = engine();
+        e.frame();
+        let mut camera = *e.scene.camera();
+        for step in 1..=2 {
+            camera.position.x += 0.05 * step as f32;
+            e.set_camera(camera);
+            let stats = e.frame();
+            assert_eq!((stats.added, stats.samples), (1, 1));
+            assert!(matches!(e.accumulator, Samples::First(_, Fill::Sparse)));
+        }
+        let mut scene = SceneFile::from_toml_str(super::super::DEFAULT_SCENE, None).unwrap().scene;
+        let s = scene.settings_mut();
+        (s.width, s.height, s.spp) = (32, 18, 1);
+        scene.set_camera(camera);
+        let exact = airlight::render(&scene, &e.preview(), &RenderObserver::none());
+        // Stopped: sample 0 again, exactly, then the running mean refines.
+        e.set_camera(camera);
+        let stats = e.frame();
+        assert_eq!((stats.added, stats.samples), (1, 1));
+        assert!(matches!(e.accumulator, Samples::First(_, Fill::Exact)));
+        assert_eq!(e.image(), exact);
         e.frame();
         scene.settings_mut().spp = 2;
         assert_eq!(e.image(), airlight::render(&scene, &e.preview(), &RenderObserver::none()));

@@ -18,7 +18,7 @@ use crate::sampling::Sampler;
 use crate::scene::Scene;
 
 mod cache;
-pub use cache::FirstSample;
+pub use cache::{Fill, FirstSample};
 
 /// March steps per ray when the medium has no closed form (height fog, a
 /// density grid, noise fog).
