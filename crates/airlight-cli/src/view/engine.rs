@@ -237,8 +237,7 @@ impl Engine {
                         // The same samples as rendering sample 0, from hits
                         // kept while the camera stands still; while it
                         // moves, with the indirect light interpolated.
-                        let fill =
-                            if moving && std::env::var_os("EXACT").is_none() { Fill::Sparse } else { Fill::Exact };
+                        let fill = if moving { Fill::Sparse } else { Fill::Exact };
                         let image = self.first.render(&self.scene, self.solution.as_ref(), &preview, fill);
                         self.accumulator = Samples::First(image, fill);
                         self.samples = 1;
