@@ -55,6 +55,14 @@ pub struct SurfaceHit {
     pub uv: Option<Vec2>,
 }
 
+impl SurfaceHit {
+    /// The unit normal on the side that a ray along `dir` comes from.
+    #[inline]
+    pub fn facing(&self, dir: Vec3) -> Vec3 {
+        if self.n.dot(dir) <= 0.0 { self.n } else { -self.n }
+    }
+}
+
 /// All of a scene's surfaces, ready for ray queries.
 #[derive(Default)]
 pub struct Geometry {
@@ -235,9 +243,8 @@ fn small_scene(records: &[Record]) -> Option<(QuadLanes, Vec<Other>)> {
     // Decided before anything is collected: a mesh's million records
     // would otherwise each get a bounding sphere only to be dropped.
     let is_quad = |r: &Record| matches!(r.prim, Prim::Quad { .. });
-    let quad_count = records.iter().filter(|r| is_quad(r)).count();
     let fits = records.len() <= SMALL_LIMIT
-        && 2 * quad_count >= records.len()
+        && 2 * records.iter().filter(|r| is_quad(r)).count() >= records.len()
         && !records.iter().any(|r| matches!(r.prim, Prim::Sdf(_)));
     if !fits {
         return None;

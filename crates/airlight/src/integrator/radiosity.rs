@@ -48,7 +48,7 @@ impl RadiosityIntegrator {
 /// interpolated from the patches `s` sees (with `seen`, a shadow ray per
 /// nearby patch) or from all nearby patches.
 pub fn indirect_radiance(scene: &Scene, solution: &Radiosity, dir: glam::Vec3, s: &SurfaceHit, seen: bool) -> Rgb {
-    let n = if s.n.dot(dir) <= 0.0 { s.n } else { -s.n };
+    let n = s.facing(dir);
     let e = if seen { solution.irradiance_seen_at(s.p, n, scene.geometry()) } else { solution.irradiance_at(s.p, n) };
     match e {
         Some(e) => scene.material_at(s).albedo(s.p, s.n) * FRAC_1_PI * e,

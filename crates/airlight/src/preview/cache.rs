@@ -195,7 +195,7 @@ impl FirstSample {
                         texel.albedo = scene.material_at(&surface).albedo(surface.p, surface.n) * FRAC_1_PI;
                         if let Some(solution) = solution {
                             if anchor(x, y) {
-                                let n = facing(&surface, &ray);
+                                let n = surface.facing(ray.dir);
                                 (texel.start, texel.len, texel.scale) = own_weights(solution, surface.p, n, weights);
                             } else {
                                 texel.indirect = Indirect::Anchors;
@@ -222,7 +222,7 @@ impl FirstSample {
                 let texel = &texels[2 * j * w + 2 * i];
                 *anchor = match &texel.hit {
                     Some(s) => {
-                        Anchor { p: s.p, n: facing(s, &texel.ray), e: own_irradiance(texel, &weights[2 * j], e) }
+                        Anchor { p: s.p, n: s.facing(texel.ray.dir), e: own_irradiance(texel, &weights[2 * j], e) }
                     }
                     None => Anchor::default(),
                 };
@@ -242,7 +242,7 @@ impl FirstSample {
         size: (usize, usize),
     ) -> Option<Rgb> {
         let ((x, y), (w, h)) = (at, size);
-        let (n, radius) = (facing(surface, ray), solution.lookup().radius());
+        let (n, radius) = (surface.facing(ray.dir), solution.lookup().radius());
         let around = |k: usize| if k % 2 == 0 { ([k, k], 1) } else { ([k - 1, k + 1], 2) };
         let ((xs, nx), (ys, ny)) = (around(x), around(y));
         let mut sum = Rgb::ZERO;
@@ -253,10 +253,7 @@ impl FirstSample {
                     Some(Anchor { p, n: m, e: Some(e) }) if same_surface(surface.p, n, p, m, radius) => sum += e,
                     // An edge of the image, a silhouette or a crease
                     // between: interpolation would reach across it.
-                    _ => {
-                        let e = solution.indirect_irradiance();
-                        return solution.lookup().interpolate(solution.patches(), surface.p, n, |i| e[i]);
-                    }
+                    _ => return solution.irradiance_at(surface.p, n),
                 }
             }
         }
@@ -318,12 +315,6 @@ fn own_irradiance(texel: &Texel, list: &[(u32, f32)], e: &[Rgb]) -> Option<Rgb> 
         let ws = &list[texel.start as usize..(texel.start + texel.len) as usize];
         ws.iter().fold(Rgb::ZERO, |sum, &(i, w)| sum + e[i as usize] * w) * texel.scale
     })
-}
-
-/// The surface's normal on the side the ray comes from: the side whose
-/// patches the lookup takes.
-fn facing(surface: &SurfaceHit, ray: &Ray) -> Vec3 {
-    if surface.n.dot(ray.dir) <= 0.0 { surface.n } else { -surface.n }
 }
 
 /// Appends the lookup's terms at `p` to `list`: (start, length, scale),
