@@ -128,7 +128,8 @@ impl FirstSample {
                 let index = y * w as usize + x;
                 let terms = &self.terms[index];
                 let indirect = |_: &SurfaceHit| e.and_then(|e| own_irradiance(terms, &self.weights[y], e));
-                *out = shade(scene, preview, &lights, &self.texels[index], camera_drawn(scene, index), indirect);
+                let traced = Traced::Objects { lights: &lights };
+                *out = shade(scene, preview, traced, &self.texels[index], camera_drawn(scene, index), indirect);
             }
         });
         image
@@ -157,11 +158,6 @@ impl FirstSample {
         });
         self.key = Some(key(scene));
     }
-
-    /// The scene's objects without the lights' surfaces.
-    pub(super) fn objects(&self) -> &Geometry {
-        &self.objects
-    }
 }
 
 /// Pixel (x, y)'s sample-0 camera ray and what it meets among `objects`,
@@ -187,24 +183,41 @@ pub(super) fn trace(scene: &Scene, objects: &Geometry, camera: &CameraRays, x: u
     (texel, sampler)
 }
 
+/// Where a texel's camera ray was traced.
+#[derive(Clone, Copy)]
+pub(super) enum Traced<'a> {
+    /// Among the objects only: the lights' surfaces where they are now
+    /// (this geometry) are tested when the texel is shaded.
+    Objects { lights: &'a Geometry },
+    /// Among all the scene's surfaces ([`Scene::geometry`]), the lights'
+    /// too: one query finds the same nearest hit (an object, of lower
+    /// index, wins a tie, as when a light's surface must be strictly
+    /// nearer).
+    Everything,
+}
+
 /// What `preview.radiance` gives for a pixel's sample 0 whose camera ray
-/// met `texel` among the objects: `sampler` is the pixel's generator after
-/// the camera's draws, `indirect` the indirect irradiance at the hit
+/// met `texel` where `traced` says: `sampler` is the pixel's generator
+/// after the camera's draws, `indirect` the indirect irradiance at the hit
 /// (asked only when no light's surface stands in front of it).
 #[inline]
 pub(super) fn shade(
     scene: &Scene,
     preview: &Preview,
-    lights: &Geometry,
+    traced: Traced,
     texel: &Texel,
     mut sampler: Sampler,
     indirect: impl FnOnce(&SurfaceHit) -> Option<Rgb>,
 ) -> Rgb {
     let ray = &texel.ray;
     let medium = scene.medium();
-    let (surface, t_end) = match lights.intersect(ray, texel.t) {
+    let light = match traced {
+        Traced::Objects { lights } => lights.intersect(ray, texel.t).map(|hit| (lights.surface(ray, hit), hit.t)),
+        Traced::Everything => texel.hit.filter(|s| s.emitter.is_some()).map(|s| (s, texel.t)),
+    };
+    let (surface, t_end) = match light {
         // A light's surface in front of the objects (it reflects nothing).
-        Some(hit) => (surface_radiance(scene, ray, &lights.surface(ray, hit), &mut sampler, medium), hit.t),
+        Some((s, t)) => (surface_radiance(scene, ray, &s, &mut sampler, medium), t),
         None => match &texel.hit {
             Some(s) => {
                 let mut l = surface_radiance(scene, ray, s, &mut sampler, medium);

@@ -15,7 +15,7 @@
 //! [`Fill::Sparse`]: super::Fill::Sparse
 
 use super::Preview;
-use super::cache::{FirstSample, Texel, camera_drawn, light_surfaces, shade, trace};
+use super::cache::{FirstSample, Texel, Traced, camera_drawn, shade, trace};
 use crate::Rgb;
 use crate::film::Image;
 use crate::geometry::SurfaceHit;
@@ -49,33 +49,32 @@ impl FirstSample {
         let camera = scene.camera().rays(s.width, s.height);
         let mut anchors = std::mem::take(&mut self.anchors);
         anchors.resize(columns * h.div_ceil(SPACING), Anchor { texel: Texel::EMPTY, e: None });
-        let objects = self.objects();
+        let everything = scene.geometry();
         anchors.par_chunks_mut(columns.max(1)).enumerate().for_each(|(j, row)| {
             for (i, anchor) in row.iter_mut().enumerate() {
-                let (texel, _) = trace(scene, objects, &camera, SPACING * i, SPACING * j);
-                // The same bits as the exact fill's weights summed.
-                let e = texel
-                    .hit
-                    .zip(solution)
-                    .and_then(|(s, solution)| solution.irradiance_at(s.p, s.facing(texel.ray.dir)));
+                let (texel, _) = trace(scene, everything, &camera, SPACING * i, SPACING * j);
+                // The same bits as the exact fill's weights summed; none on
+                // a light's surface (it reflects nothing).
+                let object = texel.hit.filter(|s| s.emitter.is_none());
+                let e =
+                    object.zip(solution).and_then(|(s, solution)| solution.irradiance_at(s.p, s.facing(texel.ray.dir)));
                 *anchor = Anchor { texel, e };
             }
         });
-        let lights = light_surfaces(scene);
         let mut image = Image::new(s.width, s.height);
         image.pixels.par_chunks_mut(w.max(1)).enumerate().for_each(|(y, row)| {
             for (x, out) in row.iter_mut().enumerate() {
                 let index = y * w + x;
                 *out = if x % SPACING == 0 && y % SPACING == 0 {
                     let anchor = &anchors[y / SPACING * columns + x / SPACING];
-                    shade(scene, preview, &lights, &anchor.texel, camera_drawn(scene, index), |_| anchor.e)
+                    shade(scene, preview, Traced::Everything, &anchor.texel, camera_drawn(scene, index), |_| anchor.e)
                 } else {
-                    let (texel, sampler) = trace(scene, objects, &camera, x, y);
+                    let (texel, sampler) = trace(scene, everything, &camera, x, y);
                     let indirect = |surface: &SurfaceHit| {
                         let solution = solution?;
                         between_anchors(solution, &anchors, surface, surface.facing(texel.ray.dir), (x, y), (w, h))
                     };
-                    shade(scene, preview, &lights, &texel, sampler, indirect)
+                    shade(scene, preview, Traced::Everything, &texel, sampler, indirect)
                 };
             }
         });
@@ -194,5 +193,35 @@ mod tests {
         assert!(cache.is_valid_for(&scene));
         let kept = cache.render(&scene, Some(&solution), &preview, Fill::Sparse);
         assert_eq!(kept, exact, "a sparse render of a cached view is the exact image");
+    }
+
+    /// Traced among all the surfaces, the lights' too, the sparse render
+    /// sees a light's surface where the exact one does, which tests the
+    /// objects and the lights apart: from the scene's own camera, which
+    /// sees the light under the ceiling, with jittered camera rays, the
+    /// anchors and every pixel of the light are the exact image's bits.
+    #[test]
+    fn a_sparse_fill_sees_the_light_where_the_exact_one_does() {
+        let mut scene = SceneFile::from_toml_str(CORNELL, None).unwrap().scene;
+        (scene.settings_mut().width, scene.settings_mut().height) = (96, 96);
+        let options = RadiosityOptions::default();
+        let solution = Radiosity::compile(&scene, &options).unwrap();
+        let preview = Preview::new(&scene, Some(&solution), AnalyticOptions::default(), RaymarchOptions::default());
+        let exact = render_samples(&scene, &preview, 0, 1, &RenderObserver::none());
+        let sparse = FirstSample::new(&scene).render(&scene, Some(&solution), &preview, Fill::Sparse);
+        let mut light = 0;
+        for y in 0..96 {
+            for x in 0..96 {
+                let (a, b) = (sparse.pixel(x, y), exact.pixel(x, y));
+                // The light's radiance is (34, 24, 8); nothing else is that bright.
+                if b.x > 20.0 {
+                    assert_eq!(a, b, "light ({x}, {y})");
+                    light += 1;
+                } else if x as usize % SPACING == 0 && y as usize % SPACING == 0 {
+                    assert_eq!(a, b, "anchor ({x}, {y})");
+                }
+            }
+        }
+        assert!(light > 20, "the light covers {light} pixels");
     }
 }
