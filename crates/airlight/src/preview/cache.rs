@@ -11,7 +11,7 @@
 //! A moving camera would refill the cache every frame, and there the
 //! lookup's weights are the largest part of the work. [`Fill::Sparse`]
 //! keeps no cache (see [`sparse`](super::sparse)): it looks the weights up
-//! only at every fourth pixel in each direction, and traces and shades the
+//! only at every other pixel in each direction, and traces and shades the
 //! pixels between in one pass. The viewer uses it while the camera moves
 //! and goes back to [`Fill::Exact`] when it stops.
 
@@ -60,7 +60,7 @@ pub enum Fill {
     /// Each pixel's own: the first sample exactly as the renderer makes it,
     /// from the cache (refilled when the view changed).
     Exact,
-    /// Each pixel's own at every fourth column of every fourth row (the
+    /// Each pixel's own at every other column of every other row (the
     /// anchors); a pixel between interpolates its neighbouring anchors'
     /// irradiance where all of them hit its surface close by, and looks up
     /// its own elsewhere (see [`sparse`](super::sparse)). It uses the
