@@ -29,7 +29,8 @@ use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 use std::f32::consts::FRAC_1_PI;
 
-/// One pixel's camera ray and what it meets among the objects.
+/// One pixel's camera ray and what it meets: among the objects in the
+/// cache, among all the surfaces in a sparse render (see [`Traced`]).
 #[derive(Clone, Copy)]
 pub(super) struct Texel {
     pub ray: Ray,
@@ -82,7 +83,8 @@ pub struct FirstSample {
     /// Per image row, the lookup weights its texels index. Kept, with the
     /// texels, from frame to frame.
     weights: Vec<Vec<(u32, f32)>>,
-    /// A sparse render's anchors, kept for the memory.
+    /// A sparse render's anchors, kept so that the next one reuses their
+    /// memory.
     pub(super) anchors: Vec<super::sparse::Anchor>,
 }
 
