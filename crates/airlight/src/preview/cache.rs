@@ -53,6 +53,10 @@ struct Texel {
 enum Indirect {
     /// Its own lookup's weights.
     Own,
+    /// A sparse fill's anchor: its irradiance is looked up once per frame
+    /// by [`FirstSample::update_anchors`] (the weights, used once, are not
+    /// kept).
+    Anchor,
     /// A sparse fill's texel between anchors: the mean of its anchors'
     /// irradiance (left and right on an anchor row; above and below on an
     /// anchor column; the four diagonal ones elsewhere) when all of them
@@ -96,9 +100,9 @@ pub struct FirstSample {
     /// The scene's objects without the lights' surfaces.
     objects: Geometry,
     texels: Vec<Texel>,
-    /// Per image row, the lookup weights its texels index. Kept, with the
-    /// texels, from frame to frame: a moving camera refills them every
-    /// frame, into the memory the last frame used.
+    /// Per image row, the lookup weights its texels index (an exact fill's
+    /// only: a sparse fill's anchors look their irradiance up each frame).
+    /// Kept, with the texels, from frame to frame.
     weights: Vec<Vec<(u32, f32)>>,
     /// After a sparse fill, each anchor's hit and its indirect irradiance
     /// this frame, (w/2) × (h/2) rounded up.
@@ -170,7 +174,7 @@ impl FirstSample {
             self.texels = vec![empty; w * h];
         }
         self.weights.resize_with(h, Vec::new);
-        let anchor = |x: usize, y: usize| fill == Fill::Exact || (x % 2 == 0 && y % 2 == 0);
+        let anchor = |x: usize, y: usize| x % 2 == 0 && y % 2 == 0;
         let objects = &self.objects;
         let camera = scene.camera().rays(s.width, s.height);
         self.texels.par_chunks_mut(w.max(1)).zip(self.weights.par_iter_mut()).enumerate().for_each(
@@ -194,9 +198,11 @@ impl FirstSample {
                         texel.t = hit.t;
                         texel.albedo = scene.material_at(&surface).albedo(surface.p, surface.n) * FRAC_1_PI;
                         if let Some(solution) = solution {
-                            if anchor(x, y) {
+                            if fill == Fill::Exact {
                                 let n = surface.facing(ray.dir);
                                 (texel.start, texel.len, texel.scale) = own_weights(solution, surface.p, n, weights);
+                            } else if anchor(x, y) {
+                                texel.indirect = Indirect::Anchor;
                             } else {
                                 texel.indirect = Indirect::Anchors;
                             }
@@ -210,19 +216,23 @@ impl FirstSample {
     }
 
     /// Each anchor's hit and indirect irradiance with the solution's values
-    /// now, for the texels between to read.
+    /// now, for the anchor and the texels between to read. Looked up here
+    /// rather than summed from weights kept by the fill: a moving camera's
+    /// fill serves one frame, and writing the weights only to read them
+    /// once cost 1.6–1.8% of a flying frame.
     fn update_anchors(&mut self, solution: &Radiosity, w: usize) {
         let columns = w.div_ceil(2);
         let rows = self.texels.len().checked_div(w).unwrap_or(0).div_ceil(2);
         self.anchors.resize(columns * rows, Anchor::default());
-        let (texels, weights) = (&self.texels, &self.weights);
-        let e = solution.indirect_irradiance();
+        let texels = &self.texels;
         self.anchors.par_chunks_mut(columns.max(1)).enumerate().for_each(|(j, row)| {
             for (i, anchor) in row.iter_mut().enumerate() {
                 let texel = &texels[2 * j * w + 2 * i];
                 *anchor = match &texel.hit {
                     Some(s) => {
-                        Anchor { p: s.p, n: s.facing(texel.ray.dir), e: own_irradiance(texel, &weights[2 * j], e) }
+                        let n = s.facing(texel.ray.dir);
+                        // The same bits as the exact fill's weights summed.
+                        Anchor { p: s.p, n, e: solution.irradiance_at(s.p, n) }
                     }
                     None => Anchor::default(),
                 };
@@ -286,6 +296,10 @@ impl FirstSample {
                     if let Some(solution) = solution {
                         let e = match texel.indirect {
                             Indirect::Own => own_irradiance(texel, &self.weights[row], solution.indirect_irradiance()),
+                            Indirect::Anchor => {
+                                let w = scene.settings().width as usize;
+                                self.anchors[row / 2 * w.div_ceil(2) + (index - row * w) / 2].e
+                            }
                             Indirect::Anchors => {
                                 let size = (scene.settings().width as usize, scene.settings().height as usize);
                                 self.between_anchors(solution, s, ray, (index - row * size.0, row), size)
