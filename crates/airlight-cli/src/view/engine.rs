@@ -321,6 +321,15 @@ mod tests {
         e
     }
 
+    /// The engine's scene, at its size, rendered with `spp` samples: what
+    /// its running mean must equal.
+    fn reference(spp: u32) -> Scene {
+        let mut scene = SceneFile::from_toml_str(super::super::DEFAULT_SCENE, None).unwrap().scene;
+        let s = scene.settings_mut();
+        (s.width, s.height, s.spp) = (32, 18, spp);
+        scene
+    }
+
     #[test]
     fn still_frames_accumulate_one_then_doubling_up_to_the_batch_then_stop() {
         let mut e = engine();
@@ -337,9 +346,7 @@ mod tests {
             e.frame();
         }
         assert_eq!(e.samples(), 8);
-        let mut scene = SceneFile::from_toml_str(super::super::DEFAULT_SCENE, None).unwrap().scene;
-        let s = scene.settings_mut();
-        (s.width, s.height, s.spp) = (32, 18, 8);
+        let scene = reference(8);
         let preview = e.preview();
         let once = airlight::render(&scene, &preview, &RenderObserver::none());
         // One accumulator under both: the same bits.
@@ -348,9 +355,7 @@ mod tests {
 
     #[test]
     fn a_first_frame_kept_as_an_image_is_the_one_sample_render_and_refines_the_same() {
-        let mut scene = SceneFile::from_toml_str(super::super::DEFAULT_SCENE, None).unwrap().scene;
-        let s = scene.settings_mut();
-        (s.width, s.height, s.spp) = (32, 18, 1);
+        let mut scene = reference(1);
         let mut e = engine();
         e.frame();
         assert!(matches!(e.accumulator, Samples::First(_, Fill::Exact)));
@@ -373,9 +378,7 @@ mod tests {
             assert_eq!((stats.added, stats.samples), (1, 1));
             assert!(matches!(e.accumulator, Samples::First(_, Fill::Sparse)));
         }
-        let mut scene = SceneFile::from_toml_str(super::super::DEFAULT_SCENE, None).unwrap().scene;
-        let s = scene.settings_mut();
-        (s.width, s.height, s.spp) = (32, 18, 1);
+        let mut scene = reference(1);
         scene.set_camera(camera);
         let exact = airlight::render(&scene, &e.preview(), &RenderObserver::none());
         // Stopped: sample 0 again, exactly, then the running mean refines.
