@@ -462,12 +462,13 @@ mod tests {
         // Measured: 3.0% and 0.017% into the corner at 192×108 (76% and
         // 0.11% if anchors across silhouettes and creases are taken too);
         // 15.0% and 0.017% from the scene's camera at the viewer's 640×360,
-        // at worst beside the light (a ceiling seen at a slant, and anchors
-        // behind the light lending the ceiling's irradiance there; a
-        // version since undone that left those anchors out gave 12.7%, and
-        // 37% with anchors every fourth pixel taken within the whole
-        // kernel radius). That camera sees the room through its open side:
-        // the background around it has no indirect light to blend.
+        // at worst at the light's edges (a ceiling seen at a slant, and,
+        // probably, anchors behind the light lending the ceiling's
+        // irradiance there; a version since undone that left those anchors
+        // out gave 12.7%, and 37% with anchors every fourth pixel taken
+        // within the whole kernel radius). That camera sees the room
+        // through its open side: the background around it has no indirect
+        // light to blend.
         let views = [(corner, (192, 108), 0.05, 0.5), (own, (640, 360), 0.2, 0.15)];
         for (camera, (w, h), worst_allowed, blended) in views {
             scene.set_camera(camera);
