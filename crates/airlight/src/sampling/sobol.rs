@@ -101,35 +101,37 @@ fn dimension_seed(seed: u32, i: u32) -> u32 {
     h ^ (h >> 16)
 }
 
-/// The bit-reversed direction numbers of dimensions 1..4 as nibble
-/// tables: entry [d][j][v] is the XOR of reversed vₖ over the set bits b of
-/// v, k = 4j + b. A point's coordinates are then eight table reads per
-/// dimension instead of a step per index bit; bit-reversed, because the
-/// Owen scramble works on the reversed value.
-const NIBBLES: [[[u32; 16]; 8]; 3] = nibble_tables();
+/// The bit-reversed direction numbers of the four dimensions as nibble
+/// tables, the four dimensions side by side: entry [j][v][d] is the XOR of
+/// dimension d's reversed vₖ over the set bits b of v, k = 4j + b. A
+/// point's four coordinates are then eight reads of four lanes instead of
+/// a step per index bit; bit-reversed, because the Owen scramble works on
+/// the reversed value (dimension 0's reversed vₖ is 2ᵏ, so its lane gives
+/// the index back).
+const NIBBLES: [[[u32; 4]; 16]; 8] = nibble_tables();
 
-const fn nibble_tables() -> [[[u32; 16]; 8]; 3] {
-    let mut t = [[[0u32; 16]; 8]; 3];
-    let mut d = 0;
-    while d < 3 {
-        let mut j = 0;
-        while j < 8 {
-            let mut v = 0;
-            while v < 16 {
+const fn nibble_tables() -> [[[u32; 4]; 16]; 8] {
+    let mut t = [[[0u32; 4]; 16]; 8];
+    let mut j = 0;
+    while j < 8 {
+        let mut v = 0;
+        while v < 16 {
+            let mut d = 0;
+            while d < 4 {
                 let mut x = 0u32;
                 let mut b = 0;
                 while b < 4 {
                     if (v >> b) & 1 == 1 {
-                        x ^= DIRECTIONS[d + 1][4 * j + b].reverse_bits();
+                        x ^= DIRECTIONS[d][4 * j + b].reverse_bits();
                     }
                     b += 1;
                 }
-                t[d][j][v] = x;
-                v += 1;
+                t[j][v][d] = x;
+                d += 1;
             }
-            j += 1;
+            v += 1;
         }
-        d += 1;
+        j += 1;
     }
     t
 }
@@ -139,20 +141,22 @@ const fn nibble_tables() -> [[[u32; 16]; 8]; 3] {
 /// [`sobol`]'s coordinates of the scrambled index with [`owen_scramble`],
 /// computed with the coordinates kept bit-reversed until the end (the
 /// reversed Sobol' point of a scrambled index is its dimension-0 value
-/// itself), which halves the bit reversals.
+/// itself), which halves the bit reversals. Written lane by lane over the
+/// four dimensions, so that the compiler does them in one vector.
 pub fn scrambled_sobol4(index: u32, seed: u32) -> [f32; 4] {
     let shuffled = owen_scramble(index, seed);
-    let mut reversed = [shuffled, 0, 0, 0];
-    for (value, table) in reversed[1..].iter_mut().zip(&NIBBLES) {
-        for (j, row) in table.iter().enumerate() {
-            *value ^= row[((shuffled >> (4 * j)) & 15) as usize];
+    let mut reversed = [0u32; 4];
+    for (j, table) in NIBBLES.iter().enumerate() {
+        let row = &table[((shuffled >> (4 * j)) & 15) as usize];
+        for d in 0..4 {
+            reversed[d] ^= row[d];
         }
     }
     let mut out = [0.0; 4];
-    for (d, slot) in out.iter_mut().enumerate() {
+    for d in 0..4 {
         let x = laine_karras(reversed[d], dimension_seed(seed, d as u32)).reverse_bits();
         // The top 24 bits: exact in an f32, strictly below 1.
-        *slot = (x >> 8) as f32 * (1.0 / (1u32 << 24) as f32);
+        out[d] = (x >> 8) as f32 * (1.0 / (1u32 << 24) as f32);
     }
     out
 }
