@@ -170,6 +170,15 @@ fn single_scattering_path_tracing_agrees_with_marching() {
     }
 }
 
+/// [`fog_scene`] with its point light moved into view.
+fn light_in_view(medium: Medium, spp: u32, seed: u64) -> Scene {
+    let mut scene = fog_scene(medium, spp, seed);
+    let mut lights = scene.lights().to_vec();
+    lights[0] = Light::point(vec3(0.5, 1.5, 1.0), Rgb::splat(60.0));
+    scene.set_lights(&lights);
+    scene
+}
+
 #[test]
 fn equiangular_light_sampling_lowers_the_error_near_lights() {
     // The same scene with the point light in view (its 1/r² glow on the
@@ -178,20 +187,60 @@ fn equiangular_light_sampling_lowers_the_error_near_lights() {
     // march. Both estimate the same integral (the test above); the second
     // has finite variance near the light.
     let medium = Medium::homogeneous(Rgb::new(0.02, 0.03, 0.04), Rgb::new(0.10, 0.07, 0.05), 0.3);
-    let in_view = |spp| {
-        let mut scene = fog_scene(medium.clone(), spp, 5);
-        let mut lights = scene.lights().to_vec();
-        lights[0] = Light::point(vec3(0.5, 1.5, 1.0), Rgb::splat(60.0));
-        scene.set_lights(&lights);
-        scene
-    };
+    let in_view = |spp| light_in_view(medium.clone(), spp, 5);
     let marched =
         render(&in_view(16), &Raymarch::new(RaymarchOptions { steps: 4096, jitter: true }), &RenderObserver::none());
     let error = |equiangular| {
-        let tracer = PathTracer { max_depth: 1, equiangular, closed_form: true, stratify: true };
+        let tracer =
+            PathTracer { equiangular, ..PathTracer::new(PathOptions { max_depth: 1, ..PathOptions::default() }) };
         compare(&render(&in_view(64), &tracer, &RenderObserver::none()), &marched).unwrap().rel_rmse
     };
     let (free_flight, with_equiangular) = (error(false), error(true));
     eprintln!("64 spp: free flights {free_flight:.4}, with equiangular {with_equiangular:.4}");
     assert!(with_equiangular < 0.5 * free_flight, "{with_equiangular} vs {free_flight}");
+}
+
+#[test]
+fn directions_drawn_toward_the_light_change_the_noise_not_the_light() {
+    // Multiple scattering in denser fog around the point light in view,
+    // eight seeds each, with new directions drawn toward the light as well
+    // and without: the image means agree within four standard errors of
+    // their difference (taken from the seeds' spread), and the seeds'
+    // pixel-by-pixel spread, which rare, bright pixels dominate without,
+    // is smaller with.
+    let medium = Medium::homogeneous(Rgb::new(0.02, 0.03, 0.05), Rgb::new(0.25, 0.2, 0.15), 0.4);
+    let seeds = 8;
+    let renders = |guide| -> Vec<Image> {
+        let tracer = PathTracer { guide, ..PathTracer::new(PathOptions { max_depth: 4, ..PathOptions::default() }) };
+        (0..seeds)
+            .map(|seed| render(&light_in_view(medium.clone(), 256, seed), &tracer, &RenderObserver::none()))
+            .collect()
+    };
+    let (without, with) = (renders(false), renders(true));
+    // Per channel: the mean over seeds of the image means, and its
+    // standard error.
+    let mean_and_error = |images: &[Image]| {
+        let means: Vec<Rgb> = images.iter().map(|i| i.mean()).collect();
+        let mean = means.iter().fold(Rgb::ZERO, |a, &m| a + m) / seeds as f32;
+        let var = means.iter().fold(Rgb::ZERO, |a, &m| a + (m - mean) * (m - mean)) / (seeds - 1) as f32;
+        (mean, (var / seeds as f32).powf(0.5))
+    };
+    // The seeds' squared spread about their pixel means, summed over pixels.
+    let spread = |images: &[Image]| -> f32 {
+        let n = images[0].pixels.len();
+        (0..n)
+            .map(|k| {
+                let mean = images.iter().fold(Rgb::ZERO, |a, i| a + i.pixels[k]) / seeds as f32;
+                images.iter().map(|i| (i.pixels[k] - mean).length_squared()).sum::<f32>()
+            })
+            .sum()
+    };
+    let ((m0, e0), (m1, e1)) = (mean_and_error(&without), mean_and_error(&with));
+    let (s0, s1) = (spread(&without), spread(&with));
+    eprintln!("means {m0} ± {e0} without, {m1} ± {e1} with; spread {s0} without, {s1} with");
+    for c in 0..3 {
+        let bound = 4.0 * (e0[c] * e0[c] + e1[c] * e1[c]).sqrt();
+        assert!((m0[c] - m1[c]).abs() < bound, "channel {c}: {} against {} (4σ {bound})", m0[c], m1[c]);
+    }
+    assert!(s1 < 0.7 * s0, "spread {s1} with, {s0} without");
 }

@@ -7,8 +7,10 @@
 //! one hero channel sampled per path and the
 //! path weighted by the balance heuristic over the three channels (r_u and
 //! r_l hold each channel's unidirectional and light-sampling path pdfs
-//! relative to the hero's).
+//! relative to the hero's). In fog around point lights, new directions are
+//! also drawn toward the brightest light (guide.rs).
 
+mod guide;
 mod nee;
 pub mod tracking;
 
@@ -16,10 +18,12 @@ use super::{Integrator, PathOptions};
 use crate::Rgb;
 use crate::geometry::{Ray, offset_origin};
 use crate::material::Material;
+use crate::medium::Medium;
 use crate::medium::{henyey_greenstein, sample_henyey_greenstein_cos};
-use crate::sampling::{Sampler, to_world};
+use crate::sampling::{Sampler, angle_uniform, to_world};
 use crate::scene::Scene;
 use glam::{Vec2, Vec3};
+use guide::{GUIDE_PROBABILITY, guide_axis, mixed_pdf};
 use nee::{Along, Fog, Segment, direct_light, equiangular_applies, equiangular_light};
 use tracking::free_flight;
 
@@ -38,6 +42,11 @@ pub struct PathTracer {
     /// delta and ratio tracking against a majorant for every medium (and no
     /// equiangular sampling), as for media without a closed form.
     pub closed_form: bool,
+    /// Also draw the new direction of a scattering event toward the point
+    /// or spot light brightest there, where equiangular sampling gathers
+    /// the next segment's light (guide.rs): without it, segments that pass
+    /// close to a point light make rare, bright pixels. On by default.
+    pub guide: bool,
     /// Stratify each pixel's samples: the camera's numbers and, at each
     /// scattering event on a surface, the light samples and the new
     /// direction come from the pixel's Owen-scrambled Sobol' points
@@ -47,7 +56,24 @@ pub struct PathTracer {
 
 impl PathTracer {
     pub fn new(options: PathOptions) -> Self {
-        PathTracer { max_depth: options.max_depth, equiangular: true, closed_form: true, stratify: options.stratify }
+        PathTracer {
+            max_depth: options.max_depth,
+            equiangular: true,
+            closed_form: true,
+            guide: true,
+            stratify: options.stratify,
+        }
+    }
+
+    /// Whether the new direction of scattering event `depth` may also be
+    /// drawn toward a point light (guide.rs): where the segment it starts
+    /// gathers delta lights' light equiangularly.
+    fn guides(&self, medium: Option<&Medium>, depth: u32) -> bool {
+        self.guide
+            && self.equiangular
+            && self.closed_form
+            && depth < self.max_depth
+            && medium.is_some_and(equiangular_applies)
     }
 
     /// The numbers of scattering event `depth` (1 for the first) on a surface.
@@ -167,23 +193,31 @@ impl Integrator for PathTracer {
                         }
                         let p = ray.at(c.t);
                         let wo = -ray.dir;
+                        let guide = if self.guides(Some(m), depth) { guide_axis(scene, p) } else { None };
                         let vertex = Vertex::Medium { p, along };
-                        l += beta
-                            * direct_light(
-                                scene,
-                                Fog { medium: Some(m), closed_form: self.closed_form },
-                                &vertex,
-                                wo,
-                                r_u,
-                                hero,
-                                sampler,
-                            );
-                        // Phase sampling: its weight p/pdf is 1.
-                        let cos = sample_henyey_greenstein_cos(m.g, direction.x);
-                        let sin = (1.0 - cos * cos).max(0.0).sqrt();
-                        let phi = 2.0 * std::f32::consts::PI * direction.y;
-                        let wi = to_world(Vec3::new(sin * phi.cos(), sin * phi.sin(), cos), wo);
-                        r_l = r_u / henyey_greenstein(cos, m.g);
+                        let fog = Fog { medium: Some(m), closed_form: self.closed_form };
+                        l += beta * direct_light(scene, fog, &vertex, wo, r_u, hero, guide, sampler);
+                        let (wi, phase) = match guide {
+                            Some(axis) if sampler.next() < GUIDE_PROBABILITY => {
+                                let wi = angle_uniform(direction, axis);
+                                (wi, m.phase(wo, wi))
+                            }
+                            _ => {
+                                let cos = sample_henyey_greenstein_cos(m.g, direction.x);
+                                let sin = (1.0 - cos * cos).max(0.0).sqrt();
+                                let phi = 2.0 * std::f32::consts::PI * direction.y;
+                                (
+                                    to_world(Vec3::new(sin * phi.cos(), sin * phi.sin(), cos), wo),
+                                    henyey_greenstein(cos, m.g),
+                                )
+                            }
+                        };
+                        // Phase sampling alone: its weight p/pdf is 1.
+                        let pdf = mixed_pdf(phase, guide, wi);
+                        if guide.is_some() {
+                            beta *= phase / pdf;
+                        }
+                        r_l = r_u / pdf;
                         prev_p = p;
                         scattered = Some(Ray::new(p, wi));
                         false
@@ -250,14 +284,29 @@ impl Integrator for PathTracer {
             let vertex =
                 Vertex::Surface { p: surface.p, n: surface.n, material: &material, light_numbers: numbers.light };
             let fog = Fog { medium, closed_form: self.closed_form };
-            l += beta * direct_light(scene, fog, &vertex, wo, r_u, hero, sampler);
-            let Some(bs) = material.sample(surface.p, surface.n, wo, numbers.direction, sampler.next()) else {
-                return l;
+            let guide = if self.guides(medium, depth) { guide_axis(scene, surface.p) } else { None };
+            l += beta * direct_light(scene, fog, &vertex, wo, r_u, hero, guide, sampler);
+            let (wi, f, pdf) = match guide {
+                Some(axis) if sampler.next() < GUIDE_PROBABILITY => {
+                    let wi = angle_uniform(numbers.direction, axis);
+                    let (f, pdf) = material.eval(surface.p, surface.n, wo, wi);
+                    (wi, f, pdf)
+                }
+                _ => {
+                    let Some(bs) = material.sample(surface.p, surface.n, wo, numbers.direction, sampler.next()) else {
+                        return l;
+                    };
+                    (bs.wi, bs.f, bs.pdf)
+                }
             };
-            beta *= bs.f * (bs.wi.dot(surface.n).abs() / bs.pdf);
-            r_l = r_u / bs.pdf;
+            let pdf = mixed_pdf(pdf, guide, wi);
+            if pdf.is_nan() || pdf <= 0.0 {
+                return l;
+            }
+            beta *= f * (wi.dot(surface.n).abs() / pdf);
+            r_l = r_u / pdf;
             prev_p = surface.p;
-            ray = Ray::new(offset_origin(surface.p, surface.n, bs.wi), bs.wi);
+            ray = Ray::new(offset_origin(surface.p, surface.n, wi), wi);
             if beta.max_element() <= 0.0 || !russian_roulette(&mut beta, r_u, depth, sampler) {
                 return l;
             }
