@@ -21,9 +21,10 @@ use crate::sampling::angle_uniform_pdf;
 use crate::scene::Scene;
 use glam::Vec3;
 
-/// The chance of drawing a new direction toward the light: the phase
-/// function or BRDF keeps the rest, so the path weight grows at most by
-/// 1/(1 − this) where the light is not the point.
+/// The chance of drawing a new direction toward the light; the phase
+/// function or BRDF draws the rest. Where the light does not matter, the
+/// path's weight (phase or BRDF × cosine over the mixture's density) is
+/// then at most 1/(1 − this) times what their sampling alone gives.
 pub(super) const GUIDE_PROBABILITY: f32 = 0.5;
 
 /// The unit direction from `p` to the point or spot light of the largest

@@ -215,6 +215,11 @@ impl Integrator for PathTracer {
                         // Phase sampling alone: its weight p/pdf is 1.
                         let pdf = mixed_pdf(phase, guide, wi);
                         if guide.is_some() {
+                            // Infinite on the axis itself, a draw of measure zero.
+                            if !pdf.is_finite() {
+                                terminated = true;
+                                return false;
+                            }
                             beta *= phase / pdf;
                         }
                         r_l = r_u / pdf;
