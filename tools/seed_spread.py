@@ -3,7 +3,7 @@
 the renders spread: the noise of one render, without a reference.
 
     python3 tools/seed_spread.py --scene scenes/compare_fog_point.toml \\
-        --spp 64 --seeds 24 OLD_BINARY NEW_BINARY
+        --spp 64 --seeds 24 OLD_BINARY NEW_BINARY [-- MORE RENDER OPTIONS]
 
 Per build: the image mean over all renders; the relative variance of one
 render (each pixel's variance across the seeds, averaged over the pixels,
@@ -21,17 +21,18 @@ tools/mitsuba_compare.py).
 import argparse
 import os
 import subprocess
+import sys
 import tempfile
 
 import mitsuba as mi
 import numpy as np
 
 
-def renders(binary: str, scene: str, spp: int, seeds: int, out: str) -> np.ndarray:
+def renders(binary: str, scene: str, spp: int, seeds: int, out: str, more: list) -> np.ndarray:
     images = []
     for seed in range(1, seeds + 1):
         path = os.path.join(out, f"seed{seed}.exr")
-        command = [binary, "render", scene, "--spp", str(spp), "--seed", str(seed), "-o", path, "--quiet"]
+        command = [binary, "render", scene, "--spp", str(spp), "--seed", str(seed), "-o", path, "--quiet", *more]
         subprocess.run(command, check=True)
         images.append(np.array(mi.Bitmap(path), dtype=np.float64)[..., :3])
     return np.array(images)
@@ -43,11 +44,15 @@ def main() -> None:
     parser.add_argument("--scene", required=True)
     parser.add_argument("--spp", type=int, default=64)
     parser.add_argument("--seeds", type=int, default=16)
-    args = parser.parse_args()
+    # What follows `--` goes to every render.
+    argv = sys.argv[1:]
+    split = argv.index("--") if "--" in argv else len(argv)
+    args = parser.parse_args(argv[:split])
+    more = argv[split + 1 :]
     mi.set_variant("scalar_rgb")
     for binary in args.binaries:
         with tempfile.TemporaryDirectory() as out:
-            images = renders(binary, args.scene, args.spp, args.seeds, out)
+            images = renders(binary, args.scene, args.spp, args.seeds, out, more)
         mean = images.mean()
         variance = images.var(axis=0, ddof=1).mean() / mean**2
         trimmed = np.sort(images, axis=0)[:-1].var(axis=0, ddof=1).mean() / mean**2
