@@ -15,7 +15,10 @@
 //! one-sample model, "Robust Monte Carlo Methods for Light Transport
 //! Simulation", 1997, §9.2.4), and so is next-event estimation's balance
 //! heuristic against area lights, which must know the density with which
-//! the direction could have been drawn.
+//! the direction could have been drawn. Russian roulette then waits until
+//! the new segment has gathered its light (mod.rs): the small weight of a
+//! direction drawn close to the axis offsets that segment's large
+//! estimate, and roulette on it would undo the offset.
 
 use crate::sampling::angle_uniform_pdf;
 use crate::scene::Scene;
