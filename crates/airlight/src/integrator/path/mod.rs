@@ -8,7 +8,7 @@
 //! path weighted by the balance heuristic over the three channels (r_u and
 //! r_l hold each channel's unidirectional and light-sampling path pdfs
 //! relative to the hero's). In fog around point lights, new directions are
-//! also drawn toward the brightest light (guide.rs).
+//! also drawn toward the brightest lights (guide.rs).
 
 mod guide;
 mod nee;
@@ -20,10 +20,10 @@ use crate::geometry::{Ray, offset_origin};
 use crate::material::Material;
 use crate::medium::Medium;
 use crate::medium::{henyey_greenstein, sample_henyey_greenstein_cos};
-use crate::sampling::{Sampler, angle_uniform, to_world};
+use crate::sampling::{Sampler, to_world};
 use crate::scene::Scene;
 use glam::{Vec2, Vec3};
-use guide::{GUIDE_PROBABILITY, guide_axis, mixed_pdf};
+use guide::{GUIDE_PROBABILITY, Guide, mixed_pdf};
 use nee::{Along, Fog, Segment, direct_light, equiangular_applies, equiangular_light};
 use tracking::free_flight;
 
@@ -43,7 +43,7 @@ pub struct PathTracer {
     /// equiangular sampling), as for media without a closed form.
     pub closed_form: bool,
     /// Also draw the new direction of a scattering event toward the point
-    /// or spot light brightest there, where equiangular sampling gathers
+    /// or spot lights brightest there, where equiangular sampling gathers
     /// the next segment's light (guide.rs): without it, segments that pass
     /// close to a point light make rare, bright pixels. On by default.
     pub guide: bool,
@@ -207,13 +207,13 @@ impl Integrator for PathTracer {
                         }
                         let p = ray.at(c.t);
                         let wo = -ray.dir;
-                        let guide = if self.guides(Some(m), depth) { guide_axis(scene, p) } else { None };
+                        let guide = if self.guides(Some(m), depth) { Guide::at(scene, p) } else { None };
                         let vertex = Vertex::Medium { p, along };
                         let fog = Fog { medium: Some(m), closed_form: self.closed_form };
-                        l += beta * direct_light(scene, fog, &vertex, wo, r_u, hero, guide, sampler);
-                        let (wi, phase) = match guide {
-                            Some(axis) if sampler.next() < GUIDE_PROBABILITY => {
-                                let wi = angle_uniform(direction, axis);
+                        l += beta * direct_light(scene, fog, &vertex, wo, r_u, hero, guide.as_ref(), sampler);
+                        let (wi, phase) = match guided(guide.as_ref(), sampler) {
+                            Some((guide, choice)) => {
+                                let wi = guide.sample(choice, direction);
                                 (wi, m.phase(wo, wi))
                             }
                             _ => {
@@ -227,7 +227,7 @@ impl Integrator for PathTracer {
                             }
                         };
                         // Phase sampling alone: its weight p/pdf is 1.
-                        let pdf = mixed_pdf(phase, guide, wi);
+                        let pdf = mixed_pdf(phase, guide.as_ref(), wi);
                         if guide.is_some() {
                             // Infinite on the axis itself, a draw of measure zero.
                             if !pdf.is_finite() {
@@ -305,11 +305,11 @@ impl Integrator for PathTracer {
             let vertex =
                 Vertex::Surface { p: surface.p, n: surface.n, material: &material, light_numbers: numbers.light };
             let fog = Fog { medium, closed_form: self.closed_form };
-            let guide = if self.guides(medium, depth) { guide_axis(scene, surface.p) } else { None };
-            l += beta * direct_light(scene, fog, &vertex, wo, r_u, hero, guide, sampler);
-            let (wi, f, pdf) = match guide {
-                Some(axis) if sampler.next() < GUIDE_PROBABILITY => {
-                    let wi = angle_uniform(numbers.direction, axis);
+            let guide = if self.guides(medium, depth) { Guide::at(scene, surface.p) } else { None };
+            l += beta * direct_light(scene, fog, &vertex, wo, r_u, hero, guide.as_ref(), sampler);
+            let (wi, f, pdf) = match guided(guide.as_ref(), sampler) {
+                Some((guide, choice)) => {
+                    let wi = guide.sample(choice, numbers.direction);
                     let (f, pdf) = material.eval(surface.p, surface.n, wo, wi);
                     (wi, f, pdf)
                 }
@@ -320,7 +320,7 @@ impl Integrator for PathTracer {
                     (bs.wi, bs.f, bs.pdf)
                 }
             };
-            let pdf = mixed_pdf(pdf, guide, wi);
+            let pdf = mixed_pdf(pdf, guide.as_ref(), wi);
             if pdf.is_nan() || pdf <= 0.0 {
                 return l;
             }
@@ -338,6 +338,15 @@ impl Integrator for PathTracer {
             }
         }
     }
+}
+
+/// Whether this scattering event draws its new direction toward a light
+/// (with chance [`GUIDE_PROBABILITY`], where there is a guide), and if so
+/// the guide and the number that chooses its light: one number for both.
+fn guided<'a>(guide: Option<&'a Guide>, sampler: &mut Sampler) -> Option<(&'a Guide, f32)> {
+    let guide = guide?;
+    let u = sampler.next();
+    (u < GUIDE_PROBABILITY).then(|| (guide, u / GUIDE_PROBABILITY))
 }
 
 /// The scattering event from which Russian roulette may end a path, as

@@ -23,7 +23,7 @@
 //! every t and the combination stays unbiased. Where a medium has no closed
 //! form the free-flight pdf is unknown and equiangular sampling is not used.
 
-use super::guide::mixed_pdf;
+use super::guide::{Guide, mixed_pdf};
 use super::tracking::track;
 use super::{Vertex, avg};
 use crate::Rgb;
@@ -175,7 +175,7 @@ const LIGHT_SHIFT_KEY: u64 = 0x5bd1_e995_9e37_79b9;
 /// it, with a shadow ray and the medium's transmittance, weighted by the
 /// balance heuristic against sampling the BRDF or phase function (area
 /// lights) or against equiangular sampling of the segment (delta lights,
-/// when the medium vertex knows its place on it). `guide`: the axis
+/// when the medium vertex knows its place on it). `guide`: the lights
 /// toward which the vertex's new direction may also be drawn (guide.rs),
 /// whose density enters the heuristic. Returns the contribution to be
 /// multiplied by the path weight β.
@@ -187,7 +187,7 @@ pub(super) fn direct_light(
     wo: Vec3,
     r_p: Rgb,
     hero: usize,
-    guide: Option<Vec3>,
+    guide: Option<&Guide>,
     sampler: &mut Sampler,
 ) -> Rgb {
     let p = vertex.p();
