@@ -192,7 +192,7 @@ pub fn camera_ray(scene: &Scene, stratified: bool, x: u32, y: u32, sampler: &mut
 }
 
 /// [`camera_ray`] with what the camera's rays share worked out once.
-fn film_ray(
+pub(crate) fn film_ray(
     film: &CameraRays,
     filter: PixelFilter,
     stratified: bool,

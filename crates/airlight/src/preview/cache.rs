@@ -25,9 +25,10 @@ use crate::film::Image;
 use crate::geometry::{Geometry, GeometryBuilder, Ray, SurfaceHit};
 use crate::integrator::{surface_radiance, through_medium};
 use crate::radiosity::Radiosity;
+use crate::render::film_ray;
 use crate::sampling::Sampler;
 use crate::scene::{PixelFilter, Scene};
-use glam::{Vec2, Vec3};
+use glam::Vec3;
 use rayon::prelude::*;
 use std::f32::consts::FRAC_1_PI;
 
@@ -46,6 +47,14 @@ struct Texel {
     len: u32,
     scale: f32,
     indirect: Indirect,
+}
+
+impl Texel {
+    /// A texel whose camera ray meets no object (yet).
+    fn missed(ray: Ray) -> Texel {
+        let (start, len, scale) = (0, 0, 0.0);
+        Texel { ray, hit: None, t: f32::INFINITY, albedo: Rgb::ZERO, start, len, scale, indirect: Indirect::Own }
+    }
 }
 
 /// Where a texel's indirect irradiance comes from.
@@ -160,18 +169,7 @@ impl FirstSample {
         let s = scene.settings();
         let (w, h) = (s.width as usize, s.height as usize);
         if self.texels.len() != w * h {
-            let ray = Ray::new(Vec3::ZERO, Vec3::Z);
-            let empty = Texel {
-                ray,
-                hit: None,
-                t: 0.0,
-                albedo: Rgb::ZERO,
-                start: 0,
-                len: 0,
-                scale: 0.0,
-                indirect: Indirect::Own,
-            };
-            self.texels = vec![empty; w * h];
+            self.texels = vec![Texel::missed(Ray::new(Vec3::ZERO, Vec3::Z)); w * h];
         }
         self.weights.resize_with(h, Vec::new);
         let anchor = |x: usize, y: usize| x % 2 == 0 && y % 2 == 0;
@@ -182,17 +180,11 @@ impl FirstSample {
                 weights.clear();
                 for (x, texel) in texels.iter_mut().enumerate() {
                     let mut sampler = first_sampler(scene, (y * w + x) as u64);
-                    let (jitter, lens) = (sampler.next2(), sampler.next2());
-                    let film = Vec2::new(x as f32, y as f32)
-                        + match s.filter {
-                            PixelFilter::Box => jitter,
-                            PixelFilter::Point => Vec2::splat(0.5),
-                        };
-                    let ray = camera.ray(film, lens);
-                    let t = f32::INFINITY;
-                    let indirect = Indirect::Own;
-                    *texel = Texel { ray, hit: None, t, albedo: Rgb::ZERO, start: 0, len: 0, scale: 0.0, indirect };
-                    if let Some(hit) = objects.intersect(&ray, t) {
+                    // The preview's camera numbers are not stratified: two
+                    // independent pairs, which `shade` skips.
+                    let ray = film_ray(&camera, s.filter, false, x as u32, y as u32, &mut sampler);
+                    *texel = Texel::missed(ray);
+                    if let Some(hit) = objects.intersect(&ray, f32::INFINITY) {
                         let surface = objects.surface(&ray, hit);
                         texel.hit = Some(surface);
                         texel.t = hit.t;

@@ -156,6 +156,9 @@ pub struct Scene {
     bounds_center: Vec3,
     bounds_radius: f32,
     light_culling: LightCulling,
+    /// The indices of the delta lights with a place (see
+    /// [`Scene::placed_delta_lights`]).
+    placed_delta: Vec<u32>,
     /// The files the scene was read from (see [`Scene::files`]).
     pub(crate) files: Vec<std::path::PathBuf>,
     /// What the scene file asked for that Airlight does not do (yet).
@@ -282,6 +285,15 @@ impl Scene {
         &self.light_culling
     }
 
+    /// The indices, in order, of the point, spot and line lights: the delta
+    /// lights with a place ([`Light::anchor`]), which the path tracer also
+    /// samples along each segment through a medium. Kept with the lights,
+    /// so that the many area lights of an emissive mesh are not walked per
+    /// scattering event.
+    pub fn placed_delta_lights(&self) -> &[u32] {
+        &self.placed_delta
+    }
+
     /// Replaces the lights (moved, dimmed, others) and brings everything
     /// that depends on them in step: the area lights' surfaces in the BVH
     /// (so the camera sees a light where it now is and its old surface casts
@@ -294,6 +306,7 @@ impl Scene {
         self.lights = lights.to_vec();
         self.light_paths.resize(self.lights.len(), None);
         self.light_culling = LightCulling::new(&self.lights);
+        self.placed_delta = placed_delta(&self.lights);
         if surfaces_moved {
             self.geometry = build_geometry(self.surfaces());
         }
@@ -442,6 +455,12 @@ pub struct Surface {
     pub emitter: Option<u32>,
 }
 
+/// See [`Scene::placed_delta_lights`].
+fn placed_delta(lights: &[Light]) -> Vec<u32> {
+    let placed = |light: &Light| light.is_delta() && light.anchor().is_some();
+    lights.iter().enumerate().filter(|(_, light)| placed(light)).map(|(i, _)| i as u32).collect()
+}
+
 fn build_geometry(surfaces: impl Iterator<Item = Surface>) -> Geometry {
     let mut geometry = GeometryBuilder::default();
     for s in surfaces {
@@ -542,6 +561,7 @@ impl SceneBuilder {
             placed.push((shape, material));
         }
         let light_culling = LightCulling::new(&lights);
+        let placed_delta = placed_delta(&lights);
         let mut scene = Scene {
             settings,
             camera,
@@ -554,6 +574,7 @@ impl SceneBuilder {
             bounds_center: Vec3::ZERO,
             bounds_radius: 1.0,
             light_culling,
+            placed_delta,
             files: Vec::new(),
             notes: Vec::new(),
         };

@@ -51,8 +51,10 @@ impl Guide {
     /// The guide at `p`; None without a point or spot light.
     pub(super) fn at(scene: &Scene, p: Vec3) -> Option<Guide> {
         let mut guide = Guide { axes: [Vec3::ZERO; GUIDED_LIGHTS], chances: [0.0; GUIDED_LIGHTS], count: 0 };
-        for light in scene.lights() {
-            let Some((position, 0.0)) = light.anchor().filter(|_| light.is_delta()) else { continue };
+        for &index in scene.placed_delta_lights() {
+            let light = &scene.lights()[index as usize];
+            // Point and spot lights: a line light's light is not ∝ 1/h.
+            let Some((position, 0.0)) = light.anchor() else { continue };
             let to = position - p;
             let distance_squared = to.length_squared();
             let score = light.intensity().max_element() / distance_squared;

@@ -122,7 +122,8 @@ pub(super) fn equiangular_light(
     let key = sampler.next_key();
     let wo = -segment.ray.dir;
     let mut total = Rgb::ZERO;
-    for (index, light) in scene.lights().iter().enumerate() {
+    for &index in scene.placed_delta_lights() {
+        let (index, light) = (index as usize, &scene.lights()[index as usize]);
         let Some(equiangular) = segment.equiangular_kept(index, light) else { continue };
         if light.reach().is_some_and(|(center, radius)| !segment.passes_within(center, radius)) {
             continue;
