@@ -65,8 +65,21 @@ impl Display {
             .spawn()
             .expect("cannot start Xvfb");
         let server = Reaped(server);
-        wait_for("Xvfb's socket", Duration::from_secs(20), || Path::new(&format!("/tmp/.X11-unix/X{n}")).exists());
-        Display { name, _server: server }
+        // The socket file appears before the server accepts clients, and a
+        // client that connects in between is refused: wait until one is
+        // answered.
+        let display = Display { name, _server: server };
+        wait_for("Xvfb to answer", Duration::from_secs(30), || {
+            Path::new(&format!("/tmp/.X11-unix/X{n}")).exists()
+                && Command::new("xdotool")
+                    .env("DISPLAY", &display.name)
+                    .arg("getdisplaygeometry")
+                    .stdout(Stdio::null())
+                    .stderr(Stdio::null())
+                    .status()
+                    .is_ok_and(|s| s.success())
+        });
+        display
     }
 
     fn run(&self, tool: &str, args: &[&str]) -> String {
@@ -127,20 +140,29 @@ fn the_window_shows_the_scene_keys_move_the_camera_switch_integrators_save_and_q
     }
     let dir = tempfile::tempdir().unwrap();
     let display = Display::start();
+    // The viewer's messages go to a file, shown if it ends before its time.
+    let log = dir.path().join("viewer.log");
     // One sample per frame keeps frames short, so that key presses are seen.
     let viewer = Command::new(env!("CARGO_BIN_EXE_airlight"))
         .env("DISPLAY", &display.name)
         .current_dir(dir.path())
         .args(["view", "--width", "320", "--height", "180", "--batch", "1", "--out", "saved"])
         .stdout(Stdio::null())
-        .stderr(Stdio::null())
+        .stderr(std::fs::File::create(&log).unwrap())
         .spawn()
         .unwrap();
-    let mut viewer = Reaped(viewer);
+    let viewer = std::cell::RefCell::new(Reaped(viewer));
     std::fs::create_dir(dir.path().join("saved")).unwrap();
+    let still_running = || {
+        if let Some(status) = viewer.borrow_mut().0.try_wait().unwrap() {
+            let said = std::fs::read_to_string(&log).unwrap_or_default();
+            panic!("the viewer ended early ({status}); it said:\n{said}");
+        }
+    };
 
     let mut window = String::new();
-    wait_for("the window", Duration::from_secs(60), || {
+    wait_for("the window", Duration::from_secs(120), || {
+        still_running();
         window = display.run("xdotool", &["search", "--name", "airlight view"]);
         !window.is_empty()
     });
@@ -149,7 +171,10 @@ fn the_window_shows_the_scene_keys_move_the_camera_switch_integrators_save_and_q
     let spp = |t: &str| -> u32 {
         t.split(" | ").find_map(|f| f.strip_suffix(" spp")).and_then(|n| n.parse().ok()).unwrap_or(0)
     };
-    wait_for("a few samples", Duration::from_secs(60), || spp(&title()) >= 4);
+    wait_for("a few samples", Duration::from_secs(60), || {
+        still_running();
+        spp(&title()) >= 4
+    });
     let t = title();
     assert!(t.contains("| preview |") && t.contains("ms/frame") && t.contains("light 1/1"), "title: {t}");
 
@@ -175,7 +200,10 @@ fn the_window_shows_the_scene_keys_move_the_camera_switch_integrators_save_and_q
 
     // W flies forward: the view changes, and refines again once still.
     display.hold("w", 0.8);
-    wait_for("refinement after the move", Duration::from_secs(60), || spp(&title()) >= 4);
+    wait_for("refinement after the move", Duration::from_secs(60), || {
+        still_running();
+        spp(&title()) >= 4
+    });
     let after = crop(&display.screenshot(&dir.path().join("after.ppm")), rect);
     let change =
         before.iter().zip(&after).map(|(&a, &b)| (a as f64 - b as f64).abs()).sum::<f64>() / before.len() as f64;
@@ -183,12 +211,18 @@ fn the_window_shows_the_scene_keys_move_the_camera_switch_integrators_save_and_q
 
     // 2 switches to ray marching.
     display.hold("2", 0.5);
-    wait_for("the raymarch integrator", Duration::from_secs(30), || title().contains("| raymarch |"));
+    wait_for("the raymarch integrator", Duration::from_secs(30), || {
+        still_running();
+        title().contains("| raymarch |")
+    });
 
     // F12 saves the image, EXR and PNG.
     display.hold("F12", 0.5);
     let saved = |ext: &str| -> PathBuf { dir.path().join(format!("saved/airlight-view-0001.{ext}")) };
-    wait_for("the saved image", Duration::from_secs(30), || saved("exr").exists() && saved("png").exists());
+    wait_for("the saved image", Duration::from_secs(30), || {
+        still_running();
+        saved("exr").exists() && saved("png").exists()
+    });
     let image = airlight::film::Image::read_exr(&saved("exr")).unwrap();
     assert_eq!((image.width, image.height), (320, 180));
 
@@ -196,7 +230,7 @@ fn the_window_shows_the_scene_keys_move_the_camera_switch_integrators_save_and_q
     display.hold("Escape", 0.5);
     let mut status = None;
     wait_for("the viewer to quit", Duration::from_secs(30), || {
-        status = viewer.0.try_wait().unwrap();
+        status = viewer.borrow_mut().0.try_wait().unwrap();
         status.is_some()
     });
     assert!(status.unwrap().success());
