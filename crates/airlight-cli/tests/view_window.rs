@@ -153,16 +153,26 @@ fn the_window_shows_the_scene_keys_move_the_camera_switch_integrators_save_and_q
         .unwrap();
     let viewer = std::cell::RefCell::new(Reaped(viewer));
     std::fs::create_dir(dir.path().join("saved")).unwrap();
-    let still_running = || {
-        if let Some(status) = viewer.borrow_mut().0.try_wait().unwrap() {
-            let said = std::fs::read_to_string(&log).unwrap_or_default();
-            panic!("the viewer ended early ({status}); it said:\n{said}");
+    // Waits for `ready`, failing with the viewer's own words if it ends
+    // first or the time runs out.
+    let wait = |what: &str, timeout: Duration, ready: &mut dyn FnMut() -> bool| {
+        let said = || std::fs::read_to_string(&log).unwrap_or_default();
+        let start = Instant::now();
+        while !ready() {
+            if let Some(status) = viewer.borrow_mut().0.try_wait().unwrap() {
+                panic!("the viewer ended ({status}) before {what}; it said:\n{}", said());
+            }
+            assert!(
+                start.elapsed() < timeout,
+                "timed out after {timeout:?} waiting for {what}; the viewer said:\n{}",
+                said()
+            );
+            std::thread::sleep(Duration::from_millis(100));
         }
     };
 
     let mut window = String::new();
-    wait_for("the window", Duration::from_secs(120), || {
-        still_running();
+    wait("the window", Duration::from_secs(120), &mut || {
         window = display.run("xdotool", &["search", "--name", "airlight view"]);
         !window.is_empty()
     });
@@ -171,10 +181,7 @@ fn the_window_shows_the_scene_keys_move_the_camera_switch_integrators_save_and_q
     let spp = |t: &str| -> u32 {
         t.split(" | ").find_map(|f| f.strip_suffix(" spp")).and_then(|n| n.parse().ok()).unwrap_or(0)
     };
-    wait_for("a few samples", Duration::from_secs(60), || {
-        still_running();
-        spp(&title()) >= 4
-    });
+    wait("a few samples", Duration::from_secs(60), &mut || spp(&title()) >= 4);
     let t = title();
     assert!(t.contains("| preview |") && t.contains("ms/frame") && t.contains("light 1/1"), "title: {t}");
 
@@ -200,10 +207,7 @@ fn the_window_shows_the_scene_keys_move_the_camera_switch_integrators_save_and_q
 
     // W flies forward: the view changes, and refines again once still.
     display.hold("w", 0.8);
-    wait_for("refinement after the move", Duration::from_secs(60), || {
-        still_running();
-        spp(&title()) >= 4
-    });
+    wait("refinement after the move", Duration::from_secs(60), &mut || spp(&title()) >= 4);
     let after = crop(&display.screenshot(&dir.path().join("after.ppm")), rect);
     let change =
         before.iter().zip(&after).map(|(&a, &b)| (a as f64 - b as f64).abs()).sum::<f64>() / before.len() as f64;
@@ -211,18 +215,12 @@ fn the_window_shows_the_scene_keys_move_the_camera_switch_integrators_save_and_q
 
     // 2 switches to ray marching.
     display.hold("2", 0.5);
-    wait_for("the raymarch integrator", Duration::from_secs(30), || {
-        still_running();
-        title().contains("| raymarch |")
-    });
+    wait("the raymarch integrator", Duration::from_secs(30), &mut || title().contains("| raymarch |"));
 
     // F12 saves the image, EXR and PNG.
     display.hold("F12", 0.5);
     let saved = |ext: &str| -> PathBuf { dir.path().join(format!("saved/airlight-view-0001.{ext}")) };
-    wait_for("the saved image", Duration::from_secs(30), || {
-        still_running();
-        saved("exr").exists() && saved("png").exists()
-    });
+    wait("the saved image", Duration::from_secs(30), &mut || saved("exr").exists() && saved("png").exists());
     let image = airlight::film::Image::read_exr(&saved("exr")).unwrap();
     assert_eq!((image.width, image.height), (320, 180));
 
