@@ -30,7 +30,7 @@ use crate::Rgb;
 use crate::geometry::{Ray, SurfaceHit};
 use crate::medium::Medium;
 use crate::sampling::{Sampler, keyed2};
-use crate::scene::{Scene, light_numbers};
+use crate::scene::Scene;
 
 /// Estimates radiance along camera rays. Implementations hold settings and
 /// what they derive from the scene; all per-ray state lives on the stack, so
@@ -287,7 +287,7 @@ pub(crate) fn for_each_light_term(
     let material = scene.material_at(surface);
     let key = sampler.next_key();
     scene.for_each_light_at(surface.p, |index, _| {
-        let u = light_numbers(keyed2(key, index as u64));
+        let u = keyed2(key, index as u64);
         let Some(sample) = scene.sample_light(index, surface.p, u) else { return };
         let cos = sample.wi.dot(surface.n).abs();
         if cos == 0.0 {

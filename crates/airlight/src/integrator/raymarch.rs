@@ -8,7 +8,7 @@ use crate::Rgb;
 use crate::geometry::Ray;
 use crate::medium::Medium;
 use crate::sampling::{Sampler, keyed2};
-use crate::scene::{Scene, light_numbers};
+use crate::scene::Scene;
 use glam::DVec3;
 
 /// The ray-marching integrator.
@@ -105,7 +105,7 @@ pub fn in_scattered(
         let mut light_in = Rgb::ZERO;
         let key = sampler.next_key();
         scene.for_each_light_at(p, |index, _| {
-            let u = light_numbers(keyed2(key, index as u64));
+            let u = keyed2(key, index as u64);
             let Some(sample) = scene.sample_light(index, p, u) else { return };
             if !scene.unoccluded(p, None, &sample) {
                 return;

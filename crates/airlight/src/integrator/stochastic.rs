@@ -134,7 +134,7 @@ impl Stochastic {
             let u_light = Vec3::new(u[1], u[2], u[3]);
             let Some((t, pdf)) = self.distance(ray, span, light.anchor(), u[0]) else { continue };
             let x = ray.at(t);
-            let Some(sample) = scene.sample_light(index, x, u_light) else { continue };
+            let Some(sample) = scene.sample_light3(index, x, u_light) else { continue };
             if !scene.unoccluded(x, None, &sample) {
                 continue;
             }

@@ -13,7 +13,8 @@ pub use attenuation::{
 };
 pub use keyframes::Keyframes;
 pub use spot::{SpotProfile, spot_falloff};
-pub use volume::{LightVolume, third_dimension};
+pub use volume::LightVolume;
+use volume::third_dimension;
 
 use crate::Rgb;
 use crate::sampling::{basis, uniform_cone};

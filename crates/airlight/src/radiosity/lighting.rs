@@ -10,7 +10,7 @@ use super::hierarchy::{Hierarchy, mix};
 use super::links::Links;
 use super::patches::Patch;
 use crate::Rgb;
-use crate::scene::{Scene, light_numbers};
+use crate::scene::Scene;
 use glam::{Vec2, Vec3A};
 use rayon::prelude::*;
 
@@ -49,7 +49,7 @@ fn patch_irradiance(scene: &Scene, p: &Patch, key: u64) -> Rgb {
             } else {
                 Vec2::new(((s % side) as f32 + jitter.x) / side as f32, ((s / side) as f32 + jitter.y) / side as f32)
             };
-            let Some(sample) = scene.sample_light(index, p.center, light_numbers(u)) else {
+            let Some(sample) = scene.sample_light(index, p.center, u) else {
                 continue;
             };
             let cos = sample.wi.dot(p.normal);

@@ -37,7 +37,7 @@ use crate::Rgb;
 use crate::camera::Camera;
 use crate::film::Tonemap;
 use crate::geometry::{Geometry, GeometryBuilder, Segment, Shape, SurfaceHit, offset_origin};
-use crate::light::{Keyframes, Light, LightSample, third_dimension};
+use crate::light::{Keyframes, Light, LightSample};
 use crate::material::Material;
 use crate::medium::Medium;
 use glam::{Affine3A, Vec2, Vec3};
@@ -350,13 +350,20 @@ impl Scene {
     }
 
     /// Light from light `index` arriving at `p`, drawn with the uniform
-    /// numbers `u` (volume lights use all three, others the first two);
-    /// None when the light sends none there. Blockers are not tested: see
-    /// [`Scene::unoccluded`]. Every light-sampling loop goes through here.
+    /// numbers `u` (see [`Light::sample`]: a volume light makes a third
+    /// from these two); None when the light sends none there. Blockers are
+    /// not tested: see [`Scene::unoccluded`]. Every light-sampling loop
+    /// goes through here or [`Scene::sample_light3`].
     #[inline]
-    pub fn sample_light(&self, index: usize, p: Vec3, u: Vec3) -> Option<LightSample> {
-        let sample = self.lights[index].sample3(p, u)?;
-        (sample.weight != Rgb::ZERO).then_some(sample)
+    pub fn sample_light(&self, index: usize, p: Vec3, u: Vec2) -> Option<LightSample> {
+        self.lights[index].sample(p, u).filter(|s| s.weight != Rgb::ZERO)
+    }
+
+    /// [`Scene::sample_light`] with three uniform numbers, all of which a
+    /// volume light uses (others the first two).
+    #[inline]
+    pub fn sample_light3(&self, index: usize, p: Vec3, u: Vec3) -> Option<LightSample> {
+        self.lights[index].sample3(p, u).filter(|s| s.weight != Rgb::ZERO)
     }
 
     /// Whether nothing blocks `sample` (a light sample seen from `p`). On a
@@ -437,13 +444,6 @@ impl Scene {
         self.set_lights(&lights);
         Ok(())
     }
-}
-
-/// Three uniform numbers for [`Scene::sample_light`] from two: the third,
-/// which only volume lights use, a hash of the two.
-#[inline]
-pub fn light_numbers(u: Vec2) -> Vec3 {
-    u.extend(third_dimension(u))
 }
 
 /// One surface of a scene: its shape in world space, its material index

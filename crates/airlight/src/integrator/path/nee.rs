@@ -33,7 +33,6 @@ use crate::light::Light;
 use crate::medium::Medium;
 use crate::sampling::{Sampler, keyed2};
 use crate::scene::Scene;
-use crate::scene::light_numbers;
 use glam::Vec3;
 
 /// How many lights' equiangular distributions a segment keeps for the
@@ -132,7 +131,7 @@ pub(super) fn equiangular_light(
         let t = equiangular.sample(u.x);
         let pdf = equiangular.pdf(t);
         let p = segment.ray.at(t);
-        let Some(ls) = scene.sample_light(index, p, light_numbers(keyed2(key, 2 * index as u64 + 1))) else {
+        let Some(ls) = scene.sample_light(index, p, keyed2(key, 2 * index as u64 + 1)) else {
             continue;
         };
         let phase = medium.phase(wo, ls.wi);
@@ -215,7 +214,7 @@ pub(super) fn direct_light(
             }
             None => keyed2(key, index as u64),
         };
-        let Some(ls) = scene.sample_light(index, p, light_numbers(u)) else { return };
+        let Some(ls) = scene.sample_light(index, p, u) else { return };
         let (f, scatter_pdf, normal) = match *vertex {
             Vertex::Surface { p, n, material: m, .. } => {
                 let (brdf, pdf) = m.eval(p, n, wo, ls.wi);
