@@ -185,18 +185,24 @@ fn equiangular_light_sampling_lowers_the_error_near_lights() {
     // image), single scattering, 64 spp: free flights alone against free
     // flights plus equiangular points with MIS, each against a 4096-step
     // march. Both estimate the same integral (the test above); the second
-    // has finite variance near the light.
+    // has finite variance near the light. The first's error over one seed
+    // is heavy-tailed (0.17 to 0.61 over 12 seeds, against 0.06 to 0.12
+    // with equiangular points), so each is the root mean square over four.
     let medium = Medium::homogeneous(Rgb::new(0.02, 0.03, 0.04), Rgb::new(0.10, 0.07, 0.05), 0.3);
-    let in_view = |spp| light_in_view(medium.clone(), spp, 5);
+    let in_view = |spp, seed| light_in_view(medium.clone(), spp, seed);
     let marched =
-        render(&in_view(16), &Raymarch::new(RaymarchOptions { steps: 4096, jitter: true }), &RenderObserver::none());
+        render(&in_view(16, 5), &Raymarch::new(RaymarchOptions { steps: 4096, jitter: true }), &RenderObserver::none());
     let error = |equiangular| {
         let tracer =
             PathTracer { equiangular, ..PathTracer::new(PathOptions { max_depth: 1, ..PathOptions::default() }) };
-        compare(&render(&in_view(64), &tracer, &RenderObserver::none()), &marched).unwrap().rel_rmse
+        let squares: f64 = (0..4)
+            .map(|seed| compare(&render(&in_view(64, seed), &tracer, &RenderObserver::none()), &marched).unwrap())
+            .map(|e| e.rel_rmse * e.rel_rmse)
+            .sum();
+        (squares / 4.0).sqrt()
     };
     let (free_flight, with_equiangular) = (error(false), error(true));
-    eprintln!("64 spp: free flights {free_flight:.4}, with equiangular {with_equiangular:.4}");
+    eprintln!("64 spp, 4 seeds: free flights {free_flight:.4}, with equiangular {with_equiangular:.4}");
     assert!(with_equiangular < 0.5 * free_flight, "{with_equiangular} vs {free_flight}");
 }
 

@@ -95,7 +95,11 @@ fn stochastic_converges_to_raymarch_with_a_volume_light() {
     // The light sits just above the view: rays pass near it, not through it.
     let scene =
         shadow_scene(vec![Light::volume_box(vec3(-0.4, 3.9, -0.4), vec3(0.4, 4.7, 0.4), Rgb::splat(15.0))], 0.0);
-    check_converges(&scene, 16, [4096, 1024, 1024]);
+    // A volume light's samples are noisier than a point's: at 16 reference
+    // samples and [4096, 1024, 1024] the errors reached 0.014 on some seeds,
+    // about the reference's own noise; at these counts, at most 0.0056 over
+    // three reference seeds and three image seeds each.
+    check_converges(&scene, 64, [8192, 4096, 4096]);
 }
 
 #[test]
