@@ -6,7 +6,7 @@
 pub mod sobol;
 
 use glam::{Vec2, Vec3};
-use rand::{RngExt, SeedableRng};
+use rand::RngExt;
 use rand_pcg::Pcg32;
 use std::f32::consts::PI;
 
@@ -18,6 +18,10 @@ pub struct Sampler {
     /// A key of (seed, pixel) for the pixel's scrambled Sobol' points.
     pixel_key: u64,
 }
+
+/// The stream every pixel's generator runs on (rand_pcg's default for
+/// `Pcg32`); pixels and samples differ by their starting state.
+const PCG_STREAM: u64 = 0x0a02_bdbf_7bb3_c0a7;
 
 /// SplitMix64's finaliser (Steele, Lea and Flood 2014): a bijective 64-bit mix.
 fn mix64(mut z: u64) -> u64 {
@@ -32,7 +36,10 @@ impl Sampler {
     pub fn for_pixel(seed: u64, pixel: u64, sample: u64) -> Self {
         let pixel_key = mix64(mix64(seed) ^ pixel);
         let key = mix64(pixel_key ^ sample.wrapping_mul(0x9e37_79b9_7f4a_7c15));
-        Self { rng: Pcg32::seed_from_u64(key), sample, pixel_key }
+        // The key is already a hash: it starts the generator directly, on
+        // one fixed stream (rand_pcg's default), rather than being hashed
+        // again into a seed as `seed_from_u64` would.
+        Self { rng: Pcg32::new(key, PCG_STREAM), sample, pixel_key }
     }
 
     /// Four stratified numbers in [0, 1): this sample's point of the pixel's
