@@ -75,7 +75,8 @@ fn check(name: &str, rays: usize, shape_t: impl Fn(Vec3, Vec3) -> f32, oracle: i
     }
     // Grazing rays whose chord is shorter than the march step may disagree.
     assert!(c.disagree * 500 <= rays, "{name}: {} of {rays} rays disagree", c.disagree);
-    assert!(c.hits_agree > rays / 5 && c.misses_agree > rays / 20, "{name}: too few hits or misses to mean much");
+    // (The triangle, the smallest target, takes about a fifth of the rays.)
+    assert!(c.hits_agree > rays / 10 && c.misses_agree > rays / 20, "{name}: too few hits or misses to mean much");
     assert!(c.worst < 1e-3, "{name}: worst distance error {}", c.worst);
 }
 
