@@ -405,11 +405,12 @@ fn area_sample(x: Vec3, normal_area: Vec3, radiance: Rgb, p: Vec3) -> Option<Lig
 }
 
 /// Solid-angle pdf of direction `wi` toward a one-sided area light sampled
-/// uniformly by area, met at distance `t`; 0 from behind.
+/// uniformly by area, met at distance `t`; 0 from behind. `normal_area` is
+/// the normal scaled by the area A, so −wi·normal_area is A·cos θ_light:
+/// the pdf t²/(A·cos θ_light) without the area's square root.
 fn area_pdf(normal_area: Vec3, wi: Vec3, t: f32) -> f32 {
-    let area = normal_area.length();
-    let cos_light = -wi.dot(normal_area) / area;
-    if cos_light <= 0.0 { 0.0 } else { t * t / (area * cos_light) }
+    let projected_area = -wi.dot(normal_area);
+    if projected_area <= 0.0 { 0.0 } else { t * t / projected_area }
 }
 
 /// Samples a sphere light over the cone of directions it subtends from `p`
