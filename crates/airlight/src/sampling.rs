@@ -162,6 +162,48 @@ pub fn uniform_sphere(u: Vec2) -> Vec3 {
 mod tests {
     use super::*;
 
+    /// Pearson's correlation of paired values.
+    fn correlation(pairs: &[(f32, f32)]) -> f64 {
+        let n = pairs.len() as f64;
+        let (mx, my) = pairs.iter().fold((0.0, 0.0), |(a, b), &(x, y)| (a + x as f64 / n, b + y as f64 / n));
+        let (mut sxy, mut sxx, mut syy) = (0.0, 0.0, 0.0);
+        for &(x, y) in pairs {
+            let (dx, dy) = (x as f64 - mx, y as f64 - my);
+            (sxy, sxx, syy) = (sxy + dx * dy, sxx + dx * dx, syy + dy * dy);
+        }
+        sxy / (sxx * syy).sqrt()
+    }
+
+    #[test]
+    fn pixel_generators_are_uniform_and_independent_of_each_other() {
+        // 64 pixels × 64 samples: the first numbers of all 4096 generators
+        // fill 16 bins evenly (χ² with 15 degrees of freedom, whose 99.99th
+        // percentile is 44.3), and are uncorrelated with those of the next
+        // pixel, of the next sample, and with each generator's own second
+        // number (|r| < 4/√n, four standard errors).
+        let first = |pixel: u64, sample: u64| Sampler::for_pixel(9, pixel, sample).next();
+        let mut bins = [0u32; 16];
+        let (mut by_pixel, mut by_sample, mut in_stream) = (Vec::new(), Vec::new(), Vec::new());
+        for pixel in 0..64 {
+            for sample in 0..64 {
+                let mut s = Sampler::for_pixel(9, pixel, sample);
+                let (u, v) = (s.next(), s.next());
+                bins[(u * 16.0) as usize] += 1;
+                by_pixel.push((u, first(pixel + 1, sample)));
+                by_sample.push((u, first(pixel, sample + 1)));
+                in_stream.push((u, v));
+            }
+        }
+        let expected = 4096.0 / 16.0;
+        let chi2: f64 = bins.iter().map(|&b| (b as f64 - expected).powi(2) / expected).sum();
+        assert!(chi2 < 44.3, "χ² {chi2:.1} over 15 degrees of freedom: {bins:?}");
+        let bound = 4.0 / 4096f64.sqrt();
+        for (what, pairs) in [("next pixel", by_pixel), ("next sample", by_sample), ("own second number", in_stream)] {
+            let r = correlation(&pairs);
+            assert!(r.abs() < bound, "correlation with the {what}: {r:.4}");
+        }
+    }
+
     #[test]
     fn basis_is_orthonormal() {
         let mut s = Sampler::for_pixel(1, 2, 3);
