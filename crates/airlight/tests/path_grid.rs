@@ -127,9 +127,8 @@ fn error_over_noise(
         b.settings_mut().seed = 2 * pair + 1;
         let (image_a, var_a) = fog_scenes::image_and_variance(&a, ia);
         let (image_b, var_b) = fog_scenes::image_and_variance(&b, ib);
-        squared +=
-            image_a.pixels.iter().zip(&image_b.pixels).map(|(x, y)| (*x - *y).length_squared() as f64).sum::<f64>();
-        expected += var_a.iter().chain(&var_b).map(|v| v.element_sum() as f64).sum::<f64>();
+        squared += fog_scenes::squared_difference(&image_a, &image_b);
+        expected += fog_scenes::summed_variance(&var_a) + fog_scenes::summed_variance(&var_b);
         first_rel_rmse.get_or_insert_with(|| compare(&image_a, &image_b).unwrap().rel_rmse);
     }
     (squared / expected, first_rel_rmse.unwrap_or(0.0))
@@ -148,9 +147,8 @@ fn error_over_variance(
     for seed in 0..4 {
         scene.settings_mut().seed = seed;
         let (image, variance) = fog_scenes::image_and_variance(&scene, integrator);
-        squared +=
-            image.pixels.iter().zip(&reference.pixels).map(|(a, b)| (*a - *b).length_squared() as f64).sum::<f64>();
-        expected += variance.iter().map(|v| v.element_sum() as f64).sum::<f64>();
+        squared += fog_scenes::squared_difference(&image, reference);
+        expected += fog_scenes::summed_variance(&variance);
         first_rel_rmse.get_or_insert_with(|| compare(&image, reference).unwrap().rel_rmse);
     }
     (squared / expected, first_rel_rmse.unwrap_or(0.0))

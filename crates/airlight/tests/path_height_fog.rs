@@ -115,10 +115,7 @@ fn single_scattering_in_height_fog_agrees_with_marching_within_noise() {
         // here; the variance estimate itself is noisy near the light).
         // Leaving the density out of the equiangular MIS weight gives
         // hundreds, with the image 20% dark.
-        let squared: f64 =
-            path.pixels.iter().zip(&marched.pixels).map(|(a, b)| (*a - *b).length_squared() as f64).sum();
-        let expected: f64 = variance.iter().map(|v| v.element_sum() as f64).sum();
-        let ratio = squared / expected;
+        let ratio = fog_scenes::squared_difference(&path, &marched) / fog_scenes::summed_variance(&variance);
         eprintln!("{name}: relative RMSE {:.4}, squared error over variance {ratio:.2}", e.rel_rmse);
         assert!(ratio < 2.0, "{name}: squared error {ratio:.2} × the variance (relative RMSE {:.4})", e.rel_rmse);
         assert!(e.rel_rmse < 0.02, "{name}: relative RMSE {:.4}", e.rel_rmse);

@@ -39,3 +39,13 @@ pub fn image_and_variance(scene: &Scene, integrator: &dyn Integrator) -> (Image,
     let sums = accumulate(scene, integrator, 0..spp as u64, 0..height, &RenderObserver::none());
     (sums.image(), sums.variance().pixels)
 }
+
+/// Σ over pixels and channels of the squared difference of two images.
+pub fn squared_difference(a: &Image, b: &Image) -> f64 {
+    a.pixels.iter().zip(&b.pixels).map(|(x, y)| (*x - *y).length_squared() as f64).sum()
+}
+
+/// Σ over pixels and channels of the variances of pixel means.
+pub fn summed_variance(variance: &[Rgb]) -> f64 {
+    variance.iter().map(|v| v.element_sum() as f64).sum()
+}
