@@ -7,9 +7,10 @@
 //! with a camera and traces one coherent primary ray per pixel of a
 //! 1024×1024 image, in 8×8 blocks, then one shadow ray from each hit toward
 //! a point light, each on one thread and then on all threads: in packets
-//! (`intersect_packet`, `occluded_packet`, 256 rays a call: eight rays at a
-//! time where the processor has AVX, and then four, as without it) and one ray at a
-//! time (`intersect`, `occluded`). Then the same rays through obvhs's
+//! (`intersect_packet`, `occluded_packet`, 256 rays a call) with each lane
+//! width the processor has, widest first (sixteen rays at a time with
+//! AVX-512, eight with AVX, four with SSE), and one ray at a time
+//! (`intersect`, `occluded`). Then the same rays through obvhs's
 //! compressed 8-wide BVH and its traversal (what Airlight used before the
 //! 4-wide tree), unless `--no-reference` is given. In between, the whole
 //! render of that image with the direct integrator (camera ray, shadow ray
@@ -20,7 +21,7 @@
 //! the one-thread passes): on a shared machine one pass of about 0.1 s can
 //! be a third off.
 
-use airlight::geometry::{Geometry, GeometryBuilder, Hit, Ray, Segment, Shape, intersect_triangle, offset_origin};
+use airlight::geometry::{GeometryBuilder, Hit, LaneWidth, Ray, Segment, Shape, intersect_triangle, offset_origin};
 use airlight::integrator::{Direct, Integrator};
 use airlight::prelude::*;
 use glam::Vec2;
@@ -104,45 +105,46 @@ fn main() {
     let primary = |rays: &[Ray]| rays.iter().map(|ray| geometry.intersect(ray, f32::INFINITY).is_some() as u64).sum();
     let occluded =
         |segments: &[Segment]| segments.iter().map(|s| geometry.occluded(s.origin, s.dir, s.tmax) as u64).sum();
-    // A packet query as a count of hits, for either lane width.
-    type Intersect = fn(&Geometry, &[Ray], f32, &mut [Option<Hit>]);
-    type Occluded = fn(&Geometry, &[Segment], &mut [bool]);
+    // A packet query on the given lanes as a count of hits.
     let geometry = &geometry;
-    let primary_with = |query: Intersect| {
+    let primary_with = |lanes: LaneWidth| {
         move |rays: &[Ray]| {
-            let mut hits = [None; CHUNK];
+            let mut hits: [Option<Hit>; CHUNK] = [None; CHUNK];
             let hits = &mut hits[..rays.len()];
-            query(geometry, rays, f32::INFINITY, hits);
+            geometry.intersect_packet_on(lanes, rays, f32::INFINITY, hits);
             hits.iter().filter(|h| h.is_some()).count() as u64
         }
     };
-    let occluded_with = |query: Occluded| {
+    let occluded_with = |lanes: LaneWidth| {
         move |segments: &[Segment]| {
             let mut blocked = [false; CHUNK];
             let blocked = &mut blocked[..segments.len()];
-            query(geometry, segments, blocked);
+            geometry.occluded_packet_on(lanes, segments, blocked);
             blocked.iter().filter(|&&b| b).count() as u64
         }
     };
-    let primary_packet = primary_with(Geometry::intersect_packet);
-    let occluded_packet = occluded_with(Geometry::occluded_packet);
-    let primary_packet4 = primary_with(Geometry::intersect_packet_four_lanes);
-    let occluded_packet4 = occluded_with(Geometry::occluded_packet_four_lanes);
-    let pp = time(&rays, primary_packet);
-    let sp = time(&shadow, occluded_packet);
-    let pp4 = time(&rays, primary_packet4);
-    let sp4 = time(&shadow, occluded_packet4);
     let p = time(&rays, primary);
     let s = time(&shadow, occluded);
-    assert_eq!((pp.sum, sp.sum), (p.sum, s.sum), "packets and single rays disagree on hits");
-    assert_eq!((pp4.sum, sp4.sum), (p.sum, s.sum), "four-lane packets and single rays disagree on hits");
-    report("Airlight BVH4, packets of coherent rays (eight lanes where the CPU has AVX)", &pp, &sp, threads);
-    report("Airlight BVH4, packets of coherent rays, four lanes (SSE)", &pp4, &sp4, threads);
-    println!(
-        "packets, AVX dispatch against four lanes, per CPU second, 1 thread: primary {:.2}×, shadow {:.2}×",
-        pp4.one_cpu / pp.one_cpu,
-        sp4.one_cpu / sp.one_cpu
-    );
+    // Each lane width this processor has, widest (the queries' default) first.
+    let mut widths =
+        LaneWidth::ALL.into_iter().filter(|l| l.available() && *l != LaneWidth::Portable).collect::<Vec<_>>();
+    widths.reverse();
+    let mut by_width = Vec::new();
+    for lanes in widths {
+        let pp = time(&rays, primary_with(lanes));
+        let sp = time(&shadow, occluded_with(lanes));
+        assert_eq!((pp.sum, sp.sum), (p.sum, s.sum), "{lanes:?}-lane packets and single rays disagree on hits");
+        report(&format!("Airlight BVH4, packets of coherent rays, {lanes:?} lanes"), &pp, &sp, threads);
+        by_width.push((lanes, pp, sp));
+    }
+    let (widest, pp, sp) = &by_width[0];
+    for (lanes, pp_n, sp_n) in &by_width[1..] {
+        println!(
+            "packets, {widest:?} lanes against {lanes:?}, per CPU second, 1 thread: primary {:.2}×, shadow {:.2}×",
+            pp_n.one_cpu / pp.one_cpu,
+            sp_n.one_cpu / sp.one_cpu
+        );
+    }
     report("Airlight BVH4, one ray at a time", &p, &s, threads);
     println!("  {:.1}% of shadow rays blocked", 100.0 * s.sum as f64 / shadow.len() as f64);
     println!(

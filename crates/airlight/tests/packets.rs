@@ -1,12 +1,12 @@
 //! Packet traversal (`Geometry::intersect_packet`, `occluded_packet`)
 //! against the one-ray queries and testing every primitive: the same hit
 //! (distance and primitive) and the same blocked-or-not for every ray, with
-//! the eight AVX lanes (where the processor has AVX: the default there),
-//! the four SSE lanes and the portable scalar lanes, for coherent camera
+//! every lane width the processor has (sixteen AVX-512 lanes, eight AVX
+//! lanes, four SSE lanes, the portable scalar lanes), for coherent camera
 //! rays of which some miss, for shadow rays of which some start blocked by
 //! a plane or end before any surface, and for incoherent random rays.
 
-use airlight::geometry::{Geometry, GeometryBuilder, Hit, Ray, Segment, Shape};
+use airlight::geometry::{Geometry, GeometryBuilder, Hit, LaneWidth, Ray, Segment, Shape};
 use airlight::sampling::{Sampler, uniform_sphere};
 use glam::{Vec2, Vec3};
 
@@ -66,36 +66,34 @@ fn camera_rays(eye: Vec3, w: u32, h: u32, fov: f32) -> Vec<Ray> {
     rays
 }
 
-/// Both lane types' packet answers against the one-ray queries (and, for
-/// `check_brute` rays, against testing every primitive). Returns the number
-/// of hits and of blocked shadow rays.
+/// Every lane width's packet answers (of those this processor has) against
+/// the one-ray queries (and, for `check_brute` rays, against testing every
+/// primitive). Returns the number of hits and of blocked shadow rays.
 fn agree(geometry: &Geometry, rays: &[Ray], tmax: f32, shadow: &[Segment], check_brute: usize) -> (usize, usize) {
     let single: Vec<Option<Hit>> = rays.iter().map(|r| geometry.intersect(r, tmax)).collect();
     for (i, r) in rays.iter().enumerate().step_by((rays.len() / check_brute.max(1)).max(1)) {
         assert_eq!(single[i], geometry.intersect_brute_force(r, tmax), "ray {i}: {r:?}");
     }
-    let mut native = vec![None; rays.len()];
-    geometry.intersect_packet(rays, tmax, &mut native);
-    let mut four = vec![None; rays.len()];
-    geometry.intersect_packet_four_lanes(rays, tmax, &mut four);
-    let mut portable = vec![None; rays.len()];
-    geometry.intersect_packet_portable(rays, tmax, &mut portable);
-    for i in 0..rays.len() {
-        assert_eq!(native[i], single[i], "ray {i}: {:?}", rays[i]);
-        assert_eq!(four[i], single[i], "ray {i} (four lanes): {:?}", rays[i]);
-        assert_eq!(portable[i], single[i], "ray {i} (portable lanes): {:?}", rays[i]);
+    for lanes in LaneWidth::ALL.into_iter().filter(|l| l.available()) {
+        let mut packets = vec![None; rays.len()];
+        geometry.intersect_packet_on(lanes, rays, tmax, &mut packets);
+        for i in 0..rays.len() {
+            assert_eq!(packets[i], single[i], "ray {i} ({lanes:?} lanes): {:?}", rays[i]);
+        }
     }
+    let mut widest = vec![None; rays.len()];
+    geometry.intersect_packet(rays, tmax, &mut widest);
+    assert_eq!(widest, single);
     let hits = single.iter().filter(|h| h.is_some()).count();
     let single: Vec<bool> = shadow.iter().map(|s| geometry.occluded(s.origin, s.dir, s.tmax)).collect();
-    let mut native = vec![false; shadow.len()];
-    geometry.occluded_packet(shadow, &mut native);
-    let mut four = vec![false; shadow.len()];
-    geometry.occluded_packet_four_lanes(shadow, &mut four);
-    let mut portable = vec![false; shadow.len()];
-    geometry.occluded_packet_portable(shadow, &mut portable);
-    assert_eq!(native, single);
-    assert_eq!(four, single);
-    assert_eq!(portable, single);
+    for lanes in LaneWidth::ALL.into_iter().filter(|l| l.available()) {
+        let mut packets = vec![false; shadow.len()];
+        geometry.occluded_packet_on(lanes, shadow, &mut packets);
+        assert_eq!(packets, single, "{lanes:?} lanes");
+    }
+    let mut widest = vec![false; shadow.len()];
+    geometry.occluded_packet(shadow, &mut widest);
+    assert_eq!(widest, single);
     (hits, single.iter().filter(|&&b| b).count())
 }
 

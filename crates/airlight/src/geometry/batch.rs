@@ -6,8 +6,8 @@
 
 use super::accel::Geometry;
 #[cfg(target_arch = "x86_64")]
-use super::lanes::{Avx8, has_avx};
-use super::lanes::{Lanes, NativeLanes, Scalar4};
+use super::lanes::{Avx8, Avx16};
+use super::lanes::{LaneWidth, Lanes, NativeLanes, Scalar4};
 use super::packet::{PACKET, Packet, lane_mask, octant};
 use super::{Hit, Ray};
 use glam::Vec3;
@@ -61,80 +61,103 @@ impl Geometry {
     /// `self.intersect(&rays[i], tmax)`, bit for bit, found by tracing
     /// neighbouring rays together. Rays are fastest in the order of nearby
     /// pixels (a tile), whose packets share most of their traversal.
-    /// Eight rays at a time where the processor has AVX, else four.
+    /// Sixteen rays at a time where the processor has AVX-512, eight where
+    /// it has AVX, else four.
     pub fn intersect_packet(&self, rays: &[Ray], tmax: f32, hits: &mut [Option<Hit>]) {
-        #[cfg(target_arch = "x86_64")]
-        if has_avx() {
-            // SAFETY: the processor has AVX.
-            return unsafe { self.intersect_packet_avx(rays, tmax, hits) };
-        }
-        self.intersect_packet_with::<NativeLanes>(rays, tmax, hits)
+        self.intersect_packet_on(LaneWidth::widest(), rays, tmax, hits)
     }
 
-    /// [`Geometry::intersect_packet`] with this target's four-lane
-    /// arithmetic even where AVX is there: for benchmarks and tests.
+    /// [`Geometry::intersect_packet`] on the given lanes, which the
+    /// processor must have ([`LaneWidth::available`]; panics if not): for
+    /// tests and benchmarks.
     #[doc(hidden)]
-    pub fn intersect_packet_four_lanes(&self, rays: &[Ray], tmax: f32, hits: &mut [Option<Hit>]) {
-        self.intersect_packet_with::<NativeLanes>(rays, tmax, hits)
+    pub fn intersect_packet_on(&self, lanes: LaneWidth, rays: &[Ray], tmax: f32, hits: &mut [Option<Hit>]) {
+        assert!(lanes.available(), "this processor has no {lanes:?} lanes");
+        match lanes {
+            LaneWidth::Portable => self.intersect_packet_with::<Scalar4>(rays, tmax, hits),
+            LaneWidth::Four => self.intersect_packet_with::<NativeLanes>(rays, tmax, hits),
+            // SAFETY: the processor has AVX (asserted above).
+            #[cfg(target_arch = "x86_64")]
+            LaneWidth::Eight => unsafe { self.intersect_packet_avx(rays, tmax, hits) },
+            // SAFETY: the processor has AVX-512F (asserted above).
+            #[cfg(target_arch = "x86_64")]
+            LaneWidth::Sixteen => unsafe { self.intersect_packet_avx512(rays, tmax, hits) },
+            #[cfg(not(target_arch = "x86_64"))]
+            LaneWidth::Eight | LaneWidth::Sixteen => unreachable!("never available here"),
+        }
     }
 
     /// The packet traversal compiled for AVX, with eight lanes.
     ///
     /// # Safety
-    /// The processor must have AVX ([`has_avx`]).
+    /// The processor must have AVX.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx")]
     unsafe fn intersect_packet_avx(&self, rays: &[Ray], tmax: f32, hits: &mut [Option<Hit>]) {
         self.intersect_packet_with::<Avx8>(rays, tmax, hits)
     }
 
-    /// [`Geometry::intersect_packet`] with the portable (scalar) four-lane
-    /// arithmetic, which targets without SSE use: for tests.
-    #[doc(hidden)]
-    pub fn intersect_packet_portable(&self, rays: &[Ray], tmax: f32, hits: &mut [Option<Hit>]) {
-        self.intersect_packet_with::<Scalar4>(rays, tmax, hits)
+    /// The packet traversal compiled for AVX-512, with sixteen lanes.
+    ///
+    /// # Safety
+    /// The processor must have AVX-512F.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx512f")]
+    unsafe fn intersect_packet_avx512(&self, rays: &[Ray], tmax: f32, hits: &mut [Option<Hit>]) {
+        self.intersect_packet_with::<Avx16>(rays, tmax, hits)
     }
 
     /// Whether something blocks each segment: `blocked[i]` is
     /// `self.occluded(s.origin, s.dir, s.tmax)` for `s = segments[i]`,
     /// traced in packets. Fastest for segments from nearby points toward
-    /// one light.
-    /// Eight rays at a time where the processor has AVX, else four.
+    /// one light. Sixteen, eight or four rays at a time, as
+    /// [`Geometry::intersect_packet`].
     pub fn occluded_packet(&self, segments: &[Segment], blocked: &mut [bool]) {
-        #[cfg(target_arch = "x86_64")]
-        if has_avx() {
-            // SAFETY: the processor has AVX.
-            return unsafe { self.occluded_packet_avx(segments, blocked) };
-        }
-        self.occluded_packet_with::<NativeLanes>(segments, blocked)
+        self.occluded_packet_on(LaneWidth::widest(), segments, blocked)
     }
 
-    /// [`Geometry::occluded_packet`] with this target's four-lane
-    /// arithmetic even where AVX is there: for benchmarks and tests.
+    /// [`Geometry::occluded_packet`] on the given lanes, which the processor
+    /// must have (panics if not): for tests and benchmarks.
     #[doc(hidden)]
-    pub fn occluded_packet_four_lanes(&self, segments: &[Segment], blocked: &mut [bool]) {
-        self.occluded_packet_with::<NativeLanes>(segments, blocked)
+    pub fn occluded_packet_on(&self, lanes: LaneWidth, segments: &[Segment], blocked: &mut [bool]) {
+        assert!(lanes.available(), "this processor has no {lanes:?} lanes");
+        match lanes {
+            LaneWidth::Portable => self.occluded_packet_with::<Scalar4>(segments, blocked),
+            LaneWidth::Four => self.occluded_packet_with::<NativeLanes>(segments, blocked),
+            // SAFETY: the processor has AVX (asserted above).
+            #[cfg(target_arch = "x86_64")]
+            LaneWidth::Eight => unsafe { self.occluded_packet_avx(segments, blocked) },
+            // SAFETY: the processor has AVX-512F (asserted above).
+            #[cfg(target_arch = "x86_64")]
+            LaneWidth::Sixteen => unsafe { self.occluded_packet_avx512(segments, blocked) },
+            #[cfg(not(target_arch = "x86_64"))]
+            LaneWidth::Eight | LaneWidth::Sixteen => unreachable!("never available here"),
+        }
     }
 
     /// The packet shadow test compiled for AVX, with eight lanes.
     ///
     /// # Safety
-    /// The processor must have AVX ([`has_avx`]).
+    /// The processor must have AVX.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx")]
     unsafe fn occluded_packet_avx(&self, segments: &[Segment], blocked: &mut [bool]) {
         self.occluded_packet_with::<Avx8>(segments, blocked)
     }
 
-    /// [`Geometry::occluded_packet`] with the portable four-lane arithmetic:
-    /// for tests.
-    #[doc(hidden)]
-    pub fn occluded_packet_portable(&self, segments: &[Segment], blocked: &mut [bool]) {
-        self.occluded_packet_with::<Scalar4>(segments, blocked)
+    /// The packet shadow test compiled for AVX-512, with sixteen lanes.
+    ///
+    /// # Safety
+    /// The processor must have AVX-512F.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx512f")]
+    unsafe fn occluded_packet_avx512(&self, segments: &[Segment], blocked: &mut [bool]) {
+        self.occluded_packet_with::<Avx16>(segments, blocked)
     }
 
-    // Inlined into the AVX entry points, so that all of it is compiled with
-    // AVX there (the lanes' operations are inlined only into such code).
+    // Inlined into the AVX and AVX-512 entry points, so that all of it is
+    // compiled with those instructions there (the lanes' operations are
+    // inlined only into such code).
     #[inline(always)]
     fn intersect_packet_with<L: Lanes>(&self, rays: &[Ray], tmax: f32, hits: &mut [Option<Hit>]) {
         assert_eq!(rays.len(), hits.len(), "one hit slot per ray");

@@ -1,24 +1,26 @@
 //! Several f32 lanes and the arithmetic the packet traversal (`packet.rs`)
-//! does on them, written once over the [`Lanes`] trait and given by three
+//! does on them, written once over the [`Lanes`] trait and given by four
 //! types: [`Scalar4`], a loop over four floats (any target, and the tests);
-//! `Sse4`, four lanes in an SSE register (the x86-64 baseline); and
-//! `Avx8`, eight lanes in an AVX register, for processors that have AVX
-//! (found at run time). Every operation is a single IEEE operation per lane
-//! (no fused multiply-add), so the three give the same bits.
+//! `Sse4`, four lanes in an SSE register (the x86-64 baseline); `Avx8`,
+//! eight lanes in an AVX register, and `Avx16`, sixteen in an AVX-512
+//! register, for processors that have them (found at run time). Every
+//! operation is a single IEEE operation per lane (no fused multiply-add),
+//! so the four give the same bits.
 
 /// `WIDTH` f32 lanes and the operations the traversal needs. Comparisons
 /// give a mask (bit i for lane i) and, like Rust's scalar comparisons, are
 /// false when either side is NaN.
 pub trait Lanes: Copy {
-    /// How many lanes: 4 or 8.
+    /// How many lanes: 4, 8 or 16.
     const WIDTH: usize;
     /// Four lanes with the same arithmetic, for a node's four child boxes.
     type Four: Lanes;
     fn splat(x: f32) -> Self;
     /// Lanes from `s[0..WIDTH]`.
     fn load(s: &[f32]) -> Self;
-    /// The lanes, in `[0..WIDTH]` of the array (the rest is zero).
-    fn to_array(self) -> [f32; 8];
+    /// The lanes as an array of `WIDTH` floats.
+    type Array: Copy + AsRef<[f32]> + std::ops::Index<usize, Output = f32>;
+    fn to_array(self) -> Self::Array;
     fn add(self, o: Self) -> Self;
     fn sub(self, o: Self) -> Self;
     fn mul(self, o: Self) -> Self;
@@ -52,6 +54,7 @@ impl Scalar4 {
 impl Lanes for Scalar4 {
     const WIDTH: usize = 4;
     type Four = Scalar4;
+    type Array = [f32; 4];
     #[inline(always)]
     fn splat(x: f32) -> Self {
         Scalar4([x; 4])
@@ -61,10 +64,8 @@ impl Lanes for Scalar4 {
         Scalar4([s[0], s[1], s[2], s[3]])
     }
     #[inline(always)]
-    fn to_array(self) -> [f32; 8] {
-        let mut out = [0.0; 8];
-        out[..4].copy_from_slice(&self.0);
-        out
+    fn to_array(self) -> [f32; 4] {
+        self.0
     }
     #[inline(always)]
     fn add(self, o: Self) -> Self {
@@ -109,7 +110,7 @@ impl Lanes for Scalar4 {
 }
 
 #[cfg(target_arch = "x86_64")]
-pub use x86::{Avx8, Sse4, has_avx};
+pub use x86::{Avx8, Avx16, Sse4, has_avx, has_avx512};
 
 #[cfg(target_arch = "x86_64")]
 mod x86 {
@@ -126,6 +127,7 @@ mod x86 {
     impl Lanes for Sse4 {
         const WIDTH: usize = 4;
         type Four = Sse4;
+        type Array = [f32; 4];
         #[inline(always)]
         fn splat(x: f32) -> Self {
             unsafe { Sse4(_mm_set1_ps(x)) }
@@ -136,8 +138,8 @@ mod x86 {
             unsafe { Sse4(_mm_loadu_ps(s.as_ptr())) }
         }
         #[inline(always)]
-        fn to_array(self) -> [f32; 8] {
-            let mut out = [0.0; 8];
+        fn to_array(self) -> [f32; 4] {
+            let mut out = [0.0; 4];
             unsafe { _mm_storeu_ps(out.as_mut_ptr(), self.0) };
             out
         }
@@ -204,6 +206,7 @@ mod x86 {
     impl Lanes for Avx8 {
         const WIDTH: usize = 8;
         type Four = Sse4;
+        type Array = [f32; 8];
         #[inline(always)]
         fn splat(x: f32) -> Self {
             unsafe { Avx8(_mm256_set1_ps(x)) }
@@ -260,6 +263,86 @@ mod x86 {
             unsafe { _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_EQ_OQ>(self.0, o.0)) as u32 }
         }
     }
+
+    /// Whether this processor has AVX-512's foundation (checked once, then
+    /// cached by std).
+    #[inline]
+    pub fn has_avx512() -> bool {
+        std::arch::is_x86_feature_detected!("avx512f")
+    }
+
+    /// Sixteen lanes in an AVX-512 register. As with [`Avx8`], only code
+    /// compiled with the feature enabled (`#[target_feature(enable =
+    /// "avx512f")]`, entered after [`has_avx512`]) may use it.
+    #[derive(Clone, Copy, Debug)]
+    pub struct Avx16(__m512);
+
+    // SAFETY (every function below): an `Avx16` is only made and used in
+    // functions that run after `has_avx512()` said yes (the type's
+    // contract); `load` reads sixteen f32s from a slice of at least sixteen
+    // (the indexing checks it) with an unaligned load. The comparisons are
+    // the ordered, quiet predicates, as [`Avx8`]'s, and give their mask
+    // register's bits directly.
+    impl Lanes for Avx16 {
+        const WIDTH: usize = 16;
+        type Four = Sse4;
+        type Array = [f32; 16];
+        #[inline(always)]
+        fn splat(x: f32) -> Self {
+            unsafe { Avx16(_mm512_set1_ps(x)) }
+        }
+        #[inline(always)]
+        fn load(s: &[f32]) -> Self {
+            let s = &s[..16];
+            unsafe { Avx16(_mm512_loadu_ps(s.as_ptr())) }
+        }
+        #[inline(always)]
+        fn to_array(self) -> [f32; 16] {
+            let mut out = [0.0; 16];
+            unsafe { _mm512_storeu_ps(out.as_mut_ptr(), self.0) };
+            out
+        }
+        #[inline(always)]
+        fn add(self, o: Self) -> Self {
+            unsafe { Avx16(_mm512_add_ps(self.0, o.0)) }
+        }
+        #[inline(always)]
+        fn sub(self, o: Self) -> Self {
+            unsafe { Avx16(_mm512_sub_ps(self.0, o.0)) }
+        }
+        #[inline(always)]
+        fn mul(self, o: Self) -> Self {
+            unsafe { Avx16(_mm512_mul_ps(self.0, o.0)) }
+        }
+        #[inline(always)]
+        fn div(self, o: Self) -> Self {
+            unsafe { Avx16(_mm512_div_ps(self.0, o.0)) }
+        }
+        #[inline(always)]
+        fn min(self, o: Self) -> Self {
+            unsafe { Avx16(_mm512_min_ps(self.0, o.0)) }
+        }
+        #[inline(always)]
+        fn max(self, o: Self) -> Self {
+            unsafe { Avx16(_mm512_max_ps(self.0, o.0)) }
+        }
+        #[inline(always)]
+        fn abs(self) -> Self {
+            unsafe { Avx16(_mm512_abs_ps(self.0)) }
+        }
+        #[inline(always)]
+        fn lt(self, o: Self) -> u32 {
+            unsafe { _mm512_cmp_ps_mask::<_CMP_LT_OQ>(self.0, o.0) as u32 }
+        }
+        #[inline(always)]
+        fn le(self, o: Self) -> u32 {
+            unsafe { _mm512_cmp_ps_mask::<_CMP_LE_OQ>(self.0, o.0) as u32 }
+        }
+        #[inline(always)]
+        fn eq(self, o: Self) -> u32 {
+            unsafe { _mm512_cmp_ps_mask::<_CMP_EQ_OQ>(self.0, o.0) as u32 }
+        }
+    }
 }
 
 /// The four-lane type this target's packets use without AVX.
@@ -267,6 +350,44 @@ mod x86 {
 pub type NativeLanes = Sse4;
 #[cfg(not(target_arch = "x86_64"))]
 pub type NativeLanes = Scalar4;
+
+/// The lanes a packet query runs on. Queries take the widest this
+/// processor has ([`LaneWidth::widest`]); tests and benchmarks name one to
+/// compare them.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LaneWidth {
+    /// [`Scalar4`]: the portable loop over four floats.
+    Portable,
+    /// [`NativeLanes`]: four lanes in an SSE register on x86-64.
+    Four,
+    /// `Avx8`: eight lanes, where the processor has AVX.
+    Eight,
+    /// `Avx16`: sixteen lanes, where the processor has AVX-512.
+    Sixteen,
+}
+
+impl LaneWidth {
+    pub const ALL: [LaneWidth; 4] = [LaneWidth::Portable, LaneWidth::Four, LaneWidth::Eight, LaneWidth::Sixteen];
+
+    /// Whether this processor has the instructions these lanes need.
+    pub fn available(self) -> bool {
+        match self {
+            LaneWidth::Portable | LaneWidth::Four => true,
+            #[cfg(target_arch = "x86_64")]
+            LaneWidth::Eight => has_avx(),
+            #[cfg(target_arch = "x86_64")]
+            LaneWidth::Sixteen => has_avx512(),
+            #[cfg(not(target_arch = "x86_64"))]
+            LaneWidth::Eight | LaneWidth::Sixteen => false,
+        }
+    }
+
+    /// The widest lanes this processor has (the answer is cached by std).
+    #[inline]
+    pub fn widest() -> Self {
+        [LaneWidth::Sixteen, LaneWidth::Eight].into_iter().find(|w| w.available()).unwrap_or(LaneWidth::Four)
+    }
+}
 
 #[cfg(test)]
 mod tests {
@@ -279,10 +400,10 @@ mod tests {
     /// Every operation of `L` against the scalar lanes, on all pairs of
     /// [`VALUES`], bit for bit.
     fn same_as_scalar<L: Lanes>() {
-        let bits = |v: [f32; 8]| v.map(f32::to_bits);
+        let bits = |v: &[f32]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
         for (i, &a) in VALUES.iter().enumerate() {
-            // Each lane a different b: a rotation of the values.
-            let b: [f32; 8] = std::array::from_fn(|k| VALUES[(i + k) % 8]);
+            // Each lane a different b (of the first eight): a rotation of the values.
+            let b: [f32; 16] = std::array::from_fn(|k| VALUES[(i + k) % 8]);
             let (x, y) = (L::splat(a), L::load(&b));
             for (k, &b) in b.iter().take(L::WIDTH).enumerate() {
                 let (s, t) = (Scalar4::splat(a), Scalar4::splat(b));
@@ -301,7 +422,7 @@ mod tests {
                 assert_eq!(x.le(y) >> k & 1, s.le(t) & 1, "{a} <= {b}");
                 assert_eq!(x.eq(y) >> k & 1, s.eq(t) & 1, "{a} == {b}");
             }
-            assert_eq!(bits(y.abs().to_array())[..L::WIDTH], bits(b.map(f32::abs))[..L::WIDTH]);
+            assert_eq!(bits(y.abs().to_array().as_ref()), bits(&b.map(f32::abs)[..L::WIDTH]));
             assert_eq!(x.lt(y) >> L::WIDTH, 0, "no bits past the lanes");
         }
     }
@@ -323,6 +444,21 @@ mod tests {
             same_as_scalar::<Avx8>();
         }
         // SAFETY: the processor has AVX (checked above).
+        unsafe { check() }
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[test]
+    fn avx512_lanes_compute_what_scalar_lanes_compute() {
+        if !has_avx512() {
+            eprintln!("skipped: this processor has no AVX-512");
+            return;
+        }
+        #[target_feature(enable = "avx512f")]
+        unsafe fn check() {
+            same_as_scalar::<Avx16>();
+        }
+        // SAFETY: the processor has AVX-512F (checked above).
         unsafe { check() }
     }
 }

@@ -13,6 +13,7 @@ mod shape;
 
 pub use accel::{Geometry, GeometryBuilder, Hit, SurfaceHit, shadow_rays_traced};
 pub use batch::Segment;
+pub use lanes::LaneWidth;
 pub use ray::{Ray, offset_origin};
 pub use sdf::Sdf;
 pub(crate) use shape::checksum;
