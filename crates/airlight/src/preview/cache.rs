@@ -172,7 +172,7 @@ impl FirstSample {
             self.texels = vec![Texel::missed(Ray::new(Vec3::ZERO, Vec3::Z)); w * h];
         }
         self.weights.resize_with(h, Vec::new);
-        let anchor = |x: usize, y: usize| x % 2 == 0 && y % 2 == 0;
+        let anchor = |x: usize, y: usize| x.is_multiple_of(2) && y.is_multiple_of(2);
         let objects = &self.objects;
         let camera = scene.camera().rays(s.width, s.height);
         self.texels.par_chunks_mut(w.max(1)).zip(self.weights.par_iter_mut()).enumerate().for_each(
@@ -250,7 +250,7 @@ impl FirstSample {
     ) -> Option<Rgb> {
         let ((x, y), (w, h)) = (at, size);
         let (n, radius) = (surface.facing(ray.dir), solution.lookup().radius());
-        let around = |k: usize| if k % 2 == 0 { ([k, k], 1) } else { ([k - 1, k + 1], 2) };
+        let around = |k: usize| if k.is_multiple_of(2) { ([k, k], 1) } else { ([k - 1, k + 1], 2) };
         let ((xs, nx), (ys, ny)) = (around(x), around(y));
         let mut sum = Rgb::ZERO;
         for &ay in &ys[..ny] {

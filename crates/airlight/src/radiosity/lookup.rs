@@ -404,7 +404,7 @@ mod tests {
             let b = probing.interpolate(&patches, p, n, value);
             assert_eq!(a, b, "at {p}, normal {n}");
             // Every third patch "unseen": the integrator's visibility filter.
-            let keep = |i: usize| i % 3 != 0;
+            let keep = |i: usize| !i.is_multiple_of(3);
             assert_eq!(
                 lists.interpolate_where(&patches, p, n, keep, value),
                 probing.interpolate_where(&patches, p, n, keep, value)
