@@ -61,7 +61,15 @@ pub fn reciprocal(d: f32) -> f32 {
 /// axis a is negative. Rays of one packet must share it.
 #[inline]
 pub fn octant(dir: Vec3) -> usize {
-    (0..3).fold(0, |o, a| o | (((reciprocal(dir[a]) < 0.0) as usize) << a))
+    (0..3).fold(0, |o, a| o | ((reciprocal_is_negative(dir[a]) as usize) << a))
+}
+
+/// Whether [`reciprocal`]`(d) < 0`, read from the sign without dividing:
+/// true for every negative d (−0 included, whose reciprocal is −10³⁰)
+/// except −∞ (whose reciprocal is −0) and NaN.
+#[inline]
+fn reciprocal_is_negative(d: f32) -> bool {
+    d.is_sign_negative() && d != f32::NEG_INFINITY && !d.is_nan()
 }
 
 impl Packet {
@@ -90,44 +98,41 @@ impl Packet {
 
     /// Refills the packet with new rays (the same contract as [`Packet::new`]),
     /// reusing its storage.
+    #[inline(always)]
     pub fn fill(&mut self, rays: impl ExactSizeIterator<Item = (Vec3, Vec3, f32)>) {
         let len = rays.len();
         assert!((1..=PACKET).contains(&len), "a packet holds 1 to {PACKET} rays, not {len}");
         self.len = len;
-        self.origin_lo = [f32::INFINITY; 3];
-        self.origin_hi = [f32::NEG_INFINITY; 3];
-        self.inv_lo = [f32::INFINITY; 3];
-        self.inv_hi = [f32::NEG_INFINITY; 3];
-        self.tmax_hi = f32::NEG_INFINITY;
-        let mut first_octant = None;
         for (i, (o, d, tmax)) in rays.enumerate() {
-            let oct = octant(d);
-            assert_eq!(*first_octant.get_or_insert(oct), oct, "rays of a packet must share their octant");
             for a in 0..3 {
-                let inv = reciprocal(d[a]);
                 self.origin[a][i] = o[a];
                 self.dir[a][i] = d[a];
-                self.inv_dir[a][i] = inv;
-                self.origin_lo[a] = self.origin_lo[a].min(o[a]);
-                self.origin_hi[a] = self.origin_hi[a].max(o[a]);
-                self.inv_lo[a] = self.inv_lo[a].min(inv);
-                self.inv_hi[a] = self.inv_hi[a].max(inv);
             }
             self.tmax[i] = tmax;
-            self.tmax_hi = self.tmax_hi.max(tmax);
-            self.id[i] = u32::MAX;
         }
-        let oct = first_octant.unwrap_or(0);
-        self.near = std::array::from_fn(|a| if oct & (1 << a) == 0 { a } else { a + 3 });
-        for i in len..PACKET {
-            for a in 0..3 {
-                self.origin[a][i] = self.origin[a][0];
-                self.dir[a][i] = self.dir[a][0];
-                self.inv_dir[a][i] = self.inv_dir[a][0];
+        // Lanes past `len` copy lane 0, so that the loops below may run over
+        // all lanes (in whole vectors): a copy changes no range.
+        for a in 0..3 {
+            let (o, d) = (self.origin[a][0], self.dir[a][0]);
+            self.origin[a][len..].fill(o);
+            self.dir[a][len..].fill(d);
+        }
+        let tmax = self.tmax[0];
+        self.tmax[len..].fill(tmax);
+        self.id = [u32::MAX; PACKET];
+        for a in 0..3 {
+            for i in 0..PACKET {
+                self.inv_dir[a][i] = reciprocal(self.dir[a][i]);
             }
-            self.tmax[i] = self.tmax[0];
-            self.id[i] = u32::MAX;
+            self.origin_lo[a] = self.origin[a].iter().fold(f32::INFINITY, |m, &x| m.min(x));
+            self.origin_hi[a] = self.origin[a].iter().fold(f32::NEG_INFINITY, |m, &x| m.max(x));
+            self.inv_lo[a] = self.inv_dir[a].iter().fold(f32::INFINITY, |m, &x| m.min(x));
+            self.inv_hi[a] = self.inv_dir[a].iter().fold(f32::NEG_INFINITY, |m, &x| m.max(x));
         }
+        self.tmax_hi = self.tmax.iter().fold(f32::NEG_INFINITY, |m, &x| m.max(x));
+        let oct = octant(Vec3::new(self.dir[0][0], self.dir[1][0], self.dir[2][0]));
+        debug_assert!((0..len).all(|i| octant(self.ray(i).1) == oct), "rays of a packet must share their octant");
+        self.near = std::array::from_fn(|a| if oct & (1 << a) == 0 { a } else { a + 3 });
     }
 
     /// The mask of all the packet's rays.
