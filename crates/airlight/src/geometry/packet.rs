@@ -335,3 +335,25 @@ impl Bvh4 {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_sign_test_is_the_reciprocal_test() {
+        let special = [0.0, -0.0, 1e-45, -1e-45, 1e-31, -1e-31, 1.0, -1.0, f32::INFINITY, f32::NEG_INFINITY, f32::NAN];
+        let mut state = 0x9e37_79b9u32;
+        let random = (0..1_000_000).map(|_| {
+            // xorshift32 over all bit patterns: every sign, exponent and NaN.
+            state ^= state << 13;
+            state ^= state >> 17;
+            state ^= state << 5;
+            f32::from_bits(state)
+        });
+        for d in special.into_iter().chain(random) {
+            assert_eq!(reciprocal_is_negative(d), reciprocal(d) < 0.0, "{d:e} ({:#x})", d.to_bits());
+            assert_eq!(reciprocal_is_negative(-d), reciprocal(-d) < 0.0, "{:e}", -d);
+        }
+    }
+}
