@@ -3,7 +3,7 @@
 //! against testing every primitive.
 
 use airlight::geometry::{
-    GeometryBuilder, Ray, Shape, intersect_box, intersect_quad, intersect_sphere, intersect_triangle,
+    GeometryBuilder, Ray, Shape, intersect_box, intersect_quad, intersect_sphere, intersect_triangle, triangle_blocks,
 };
 use airlight::sampling::{Sampler, uniform_sphere};
 use glam::{Affine3A, DVec3, Quat, Vec3};
@@ -134,6 +134,27 @@ fn triangle_matches_oracle() {
             })
         },
     );
+}
+
+#[test]
+fn triangle_blocks_where_the_hit_lies_before_the_segments_end() {
+    // The shadow test without a division against the hit distance, on
+    // segments that end before, near and after the triangle, from both of
+    // its sides. They may differ only in a rounding's last bit, which
+    // random rays do not meet.
+    let (a, b, c) = (Vec3::new(-1.2, -0.5, 0.0), Vec3::new(1.0, -0.8, 0.4), Vec3::new(0.1, 1.3, -0.3));
+    let mut s = Sampler::for_pixel(11, 0, 0);
+    let (mut blocked, mut open) = (0, 0);
+    for _ in 0..200_000 {
+        let o = uniform_sphere(s.next2()) * (1.0 + 3.0 * s.next());
+        let target = Vec3::new(2.4 * s.next() - 1.2, 2.4 * s.next() - 1.0, 0.8 * s.next() - 0.4);
+        let d = (target - o).normalize();
+        let tmax = (target - o).length() * 2.0 * s.next();
+        let expected = intersect_triangle(a, b - a, c - a, o, d, 0.0, tmax) < tmax;
+        assert_eq!(triangle_blocks(a, b - a, c - a, o, d, tmax), expected, "{o} {d} {tmax}");
+        if expected { blocked += 1 } else { open += 1 }
+    }
+    assert!(blocked > 20_000 && open > 20_000, "{blocked} blocked, {open} open");
 }
 
 /// A shape added to a Geometry, intersected through the BVH.

@@ -11,7 +11,7 @@ use super::records::{
     Instance, NO_UV, PlaneRecord, Prim, Record, SdfPrim, UNBOUNDED_FAR, UnboundedSdf, barycentric, intersect_plane,
 };
 use super::sdf::sphere_trace;
-use super::shape::{Shape, intersect_triangle};
+use super::shape::{Shape, intersect_triangle, triangle_blocks};
 use glam::{Mat3, Vec2, Vec3, Vec3A};
 use obvhs::{BvhBuildParams, aabb::Aabb};
 use std::time::Duration;
@@ -386,7 +386,14 @@ impl Geometry {
     pub(super) fn occluded_bvh(&self, bvh: &Bvh4, origin: Vec3, dir: Vec3, tmax: f32) -> bool {
         let box_ray = BoxRay::new(origin.to_array(), dir.to_array());
         bvh.any(&box_ray, tmax, |first, count, mixed| {
-            (first..first + count).any(|i| self.intersect_one(i as usize, mixed, origin, dir, tmax) < tmax)
+            (first..first + count).any(|i| {
+                if mixed {
+                    self.records[i as usize].prim.intersect(origin, dir, 0.0, tmax) < tmax
+                } else {
+                    let [v0, e1, e2] = self.triangles[i as usize];
+                    triangle_blocks(v0, e1, e2, origin, dir, tmax)
+                }
+            })
         })
     }
 

@@ -315,8 +315,7 @@ impl Geometry {
         for i in first..first + count {
             let triangle = &self.triangles[i as usize];
             for (s, lanes) in groups::<L>(rays & !blocked) {
-                let (hit, t) = p.triangle_lanes::<L>(s, triangle);
-                blocked |= ((hit & lanes & t.lt(L::load(&p.tmax[s..]))) as u64) << s;
+                blocked |= ((p.triangle_blocks_lanes::<L>(s, triangle) & lanes) as u64) << s;
             }
             if blocked == rays {
                 break;

@@ -30,6 +30,9 @@ pub trait Lanes: Copy {
     /// `self.max(o)` where neither is NaN.
     fn max(self, o: Self) -> Self;
     fn abs(self) -> Self;
+    /// `self` with its sign flipped in the lanes where `sign_of`'s sign bit
+    /// is set (exact: a multiplication by ±1 without rounding).
+    fn flip_sign(self, sign_of: Self) -> Self;
     fn lt(self, o: Self) -> u32;
     fn le(self, o: Self) -> u32;
     fn eq(self, o: Self) -> u32;
@@ -94,6 +97,10 @@ impl Lanes for Scalar4 {
     #[inline(always)]
     fn abs(self) -> Self {
         Scalar4(self.0.map(f32::abs))
+    }
+    #[inline(always)]
+    fn flip_sign(self, sign_of: Self) -> Self {
+        self.map2(sign_of, |a, b| f32::from_bits(a.to_bits() ^ (b.to_bits() & 0x8000_0000)))
     }
     #[inline(always)]
     fn lt(self, o: Self) -> u32 {
@@ -170,6 +177,10 @@ mod x86 {
         #[inline(always)]
         fn abs(self) -> Self {
             unsafe { Sse4(_mm_and_ps(self.0, _mm_castsi128_ps(_mm_set1_epi32(i32::MAX)))) }
+        }
+        #[inline(always)]
+        fn flip_sign(self, sign_of: Self) -> Self {
+            unsafe { Sse4(_mm_xor_ps(self.0, _mm_and_ps(sign_of.0, _mm_set1_ps(-0.0)))) }
         }
         #[inline(always)]
         fn lt(self, o: Self) -> u32 {
@@ -251,6 +262,10 @@ mod x86 {
             unsafe { Avx8(_mm256_and_ps(self.0, _mm256_castsi256_ps(_mm256_set1_epi32(i32::MAX)))) }
         }
         #[inline(always)]
+        fn flip_sign(self, sign_of: Self) -> Self {
+            unsafe { Avx8(_mm256_xor_ps(self.0, _mm256_and_ps(sign_of.0, _mm256_set1_ps(-0.0)))) }
+        }
+        #[inline(always)]
         fn lt(self, o: Self) -> u32 {
             unsafe { _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LT_OQ>(self.0, o.0)) as u32 }
         }
@@ -329,6 +344,14 @@ mod x86 {
         #[inline(always)]
         fn abs(self) -> Self {
             unsafe { Avx16(_mm512_abs_ps(self.0)) }
+        }
+        #[inline(always)]
+        fn flip_sign(self, sign_of: Self) -> Self {
+            // Bitwise operations on floats need AVX-512DQ; on integers, only F.
+            unsafe {
+                let sign = _mm512_and_epi32(_mm512_castps_si512(sign_of.0), _mm512_set1_epi32(i32::MIN));
+                Avx16(_mm512_castsi512_ps(_mm512_xor_epi32(_mm512_castps_si512(self.0), sign)))
+            }
         }
         #[inline(always)]
         fn lt(self, o: Self) -> u32 {
@@ -412,6 +435,10 @@ mod tests {
                 assert_eq!(lane(x.add(y)), one(s.add(t)), "{a} + {b}");
                 assert_eq!(lane(x.sub(y)), one(s.sub(t)), "{a} - {b}");
                 assert_eq!(lane(x.mul(y)), one(s.mul(t)), "{a} * {b}");
+                assert_eq!(lane(x.flip_sign(y)), one(s.flip_sign(t)), "{a} flipped by the sign of {b}");
+                assert_eq!(lane(y.flip_sign(x)), one(t.flip_sign(s)), "{b} flipped by the sign of {a}");
+                let flipped = if b.is_sign_negative() { -a } else { a };
+                assert_eq!(one(s.flip_sign(t)), flipped.to_bits(), "{a} flipped by the sign of {b}");
                 let (q, r) = (x.div(y).to_array()[k], s.div(t).to_array()[0]);
                 assert!(q.to_bits() == r.to_bits() || (q.is_nan() && r.is_nan()), "{a} / {b}");
                 if !a.is_nan() && !b.is_nan() {

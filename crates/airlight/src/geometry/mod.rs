@@ -17,4 +17,4 @@ pub use lanes::LaneWidth;
 pub use ray::{Ray, offset_origin};
 pub use sdf::Sdf;
 pub(crate) use shape::checksum;
-pub use shape::{Shape, intersect_box, intersect_quad, intersect_sphere, intersect_triangle};
+pub use shape::{Shape, intersect_box, intersect_quad, intersect_sphere, intersect_triangle, triangle_blocks};

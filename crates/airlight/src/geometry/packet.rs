@@ -201,11 +201,11 @@ impl Packet {
         (tnear.le(tfar), [t[0], t[1], t[2], t[3]])
     }
 
-    /// Möller–Trumbore against rays `s..s + L::WIDTH`, operation for operation as
-    /// [`super::intersect_triangle`]: the mask of lanes with a hit at t > 0
-    /// (no upper bound applied) and the lanes' t.
+    /// Möller–Trumbore's terms for rays `s..s + L::WIDTH`, operation for
+    /// operation as [`super::intersect_triangle`]: the determinant and the
+    /// numerators of u, v and t (each still to be divided by it).
     #[inline(always)]
-    pub fn triangle_lanes<L: Lanes>(&self, s: usize, triangle: &[Vec3; 3]) -> (u32, L) {
+    fn triangle_terms<L: Lanes>(&self, s: usize, triangle: &[Vec3; 3]) -> [L; 4] {
         let d = [L::load(&self.dir[0][s..]), L::load(&self.dir[1][s..]), L::load(&self.dir[2][s..])];
         let o = [L::load(&self.origin[0][s..]), L::load(&self.origin[1][s..]), L::load(&self.origin[2][s..])];
         // Each component read on its own: copying the 12-byte vectors whole
@@ -218,17 +218,41 @@ impl Packet {
         let dot = |a: &[L; 3], b: &[L; 3]| a[0].mul(b[0]).add(a[1].mul(b[1])).add(a[2].mul(b[2]));
         let pvec = cross(&d, &e2);
         let det = dot(&e1, &pvec);
+        let tvec = [o[0].sub(L::splat(v0.x)), o[1].sub(L::splat(v0.y)), o[2].sub(L::splat(v0.z))];
+        let qvec = cross(&tvec, &e1);
+        [det, dot(&tvec, &pvec), dot(&d, &qvec), dot(&e2, &qvec)]
+    }
+
+    /// Möller–Trumbore against rays `s..s + L::WIDTH`, operation for operation as
+    /// [`super::intersect_triangle`]: the mask of lanes with a hit at t > 0
+    /// (no upper bound applied) and the lanes' t.
+    #[inline(always)]
+    pub fn triangle_lanes<L: Lanes>(&self, s: usize, triangle: &[Vec3; 3]) -> (u32, L) {
+        let [det, u, v, t] = self.triangle_terms::<L>(s, triangle);
         let ok_det = !det.abs().lt(L::splat(1e-20)) & lane_mask::<L>() as u32;
         let inv_det = L::splat(1.0).div(det);
-        let tvec = [o[0].sub(L::splat(v0.x)), o[1].sub(L::splat(v0.y)), o[2].sub(L::splat(v0.z))];
-        let u = dot(&tvec, &pvec).mul(inv_det);
+        let u = u.mul(inv_det);
         let ok_u = L::splat(0.0).le(u) & u.le(L::splat(1.0));
-        let qvec = cross(&tvec, &e1);
-        let v = dot(&d, &qvec).mul(inv_det);
+        let v = v.mul(inv_det);
         let miss_v = v.lt(L::splat(0.0)) | L::splat(1.0).lt(u.add(v));
-        let t = dot(&e2, &qvec).mul(inv_det);
+        let t = t.mul(inv_det);
         let ok_t = L::splat(0.0).lt(t);
         (ok_det & ok_u & !miss_v & ok_t, t)
+    }
+
+    /// Of rays `s..s + L::WIDTH`, those the triangle blocks before their
+    /// `tmax`, operation for operation as [`super::triangle_blocks`] (no
+    /// division).
+    #[inline(always)]
+    pub fn triangle_blocks_lanes<L: Lanes>(&self, s: usize, triangle: &[Vec3; 3]) -> u32 {
+        let [det, u, v, t] = self.triangle_terms::<L>(s, triangle);
+        let abs_det = det.abs();
+        let ok_det = !abs_det.lt(L::splat(1e-20)) & lane_mask::<L>() as u32;
+        let (u, v, t) = (u.flip_sign(det), v.flip_sign(det), t.flip_sign(det));
+        let ok_u = L::splat(0.0).le(u) & u.le(abs_det);
+        let miss_v = v.lt(L::splat(0.0)) | abs_det.lt(u.add(v));
+        let ok_t = L::splat(0.0).lt(t) & t.lt(L::load(&self.tmax[s..]).mul(abs_det));
+        ok_det & ok_u & !miss_v & ok_t
     }
 }
 
