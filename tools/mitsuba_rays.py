@@ -17,8 +17,9 @@ Airlight's `intersect_packet`) and `scene.ray_test` (any hit, as
 `occluded_packet`), both marked coherent. Each is timed after a warm-up
 call that compiles its kernel, waiting for the result (`dr.eval`,
 `dr.sync_thread`), as the median of --passes passes. Airlight's figures are
-bench_bvh's medians on all threads (packets, eight lanes where the
-processor has AVX), run from --bench unless --no-airlight is given.
+bench_bvh's medians on all threads (packets on the widest lanes the
+processor has: sixteen with AVX-512, eight with AVX), run from --bench
+unless --no-airlight is given.
 """
 
 import argparse
@@ -82,7 +83,7 @@ def timed(passes, run):
 
 def airlight_figures(bench):
     """bench_bvh's all-thread rays per second (M) for its packets:
-    {'primary': x, 'shadow': y}, from its first report (eight lanes)."""
+    {'primary': x, 'shadow': y}, from its first report (the widest lanes)."""
     out = subprocess.run([bench, "--no-reference"], capture_output=True, text=True, check=True).stdout
     figures = {}
     for line in out.splitlines():
