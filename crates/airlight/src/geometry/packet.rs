@@ -74,7 +74,9 @@ fn reciprocal_is_negative(d: f32) -> bool {
 
 impl Packet {
     /// A packet of `rays` (origin, direction, tmax), at most [`PACKET`] of
-    /// them, all in one [`octant`].
+    /// them, all in one [`octant`]. Inlined, as [`Packet::fill`], so that it
+    /// runs on the caller's lanes (a render's packets are mostly one a call).
+    #[inline(always)]
     pub fn new(rays: impl ExactSizeIterator<Item = (Vec3, Vec3, f32)>) -> Box<Packet> {
         let len = rays.len();
         assert!((1..=PACKET).contains(&len), "a packet holds 1 to {PACKET} rays, not {len}");
