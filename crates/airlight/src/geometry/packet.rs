@@ -7,13 +7,15 @@
 //! range of origins and of reciprocal directions, Boulos et al., "Packet-based
 //! Whitted and distribution ray tracing", 2007), which drops children that no
 //! ray of the packet can enter without testing any ray. A child that passes
-//! is then tested ray by ray, a group of rays at a time (four or eight, the
-//! width of the [`Lanes`]), when it is visited (so that the rays' nearest
-//! hits found meanwhile cull it), and only the rays that enter it go on.
+//! is then tested ray by ray, a group of rays at a time (four, eight or
+//! sixteen, the width of the [`Lanes`]), when it is visited (so that the
+//! rays' nearest hits found meanwhile cull it), and only the rays that
+//! enter it go on.
 //! Leaves test their triangles against a group of rays at a time with the
 //! same arithmetic, operation for operation, as the one-ray
-//! [`intersect_triangle`](super::intersect_triangle), so a ray's hit
-//! distance is the same bits whichever way it is traced.
+//! [`intersect_triangle`](super::intersect_triangle) (shadow rays: as
+//! [`triangle_blocks`](super::triangle_blocks)), so a ray's hit distance,
+//! or blocked-or-not, is the same bits whichever way it is traced.
 //!
 //! All rays of a packet share their direction's sign on each axis (the
 //! caller groups rays so), which makes the near plane of every box the same
