@@ -379,9 +379,9 @@ pub type NativeLanes = Scalar4;
 /// compare them.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum LaneWidth {
-    /// [`Scalar4`]: the portable loop over four floats.
+    /// `Scalar4`: the portable loop over four floats.
     Portable,
-    /// [`NativeLanes`]: four lanes in an SSE register on x86-64.
+    /// `NativeLanes`: four lanes in an SSE register on x86-64.
     Four,
     /// `Avx8`: eight lanes, where the processor has AVX.
     Eight,
