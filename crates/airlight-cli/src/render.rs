@@ -101,7 +101,7 @@ pub struct RenderArgs {
     #[arg(long, value_parser = parse_light_quadrature)]
     light_quadrature: Option<LightQuadrature>,
     /// A medium instead of the scene's (a glTF file has none): the keys of
-    /// a scene file's [medium] as `key=value` pairs separated by commas,
+    /// a scene file's `[medium]` as `key=value` pairs separated by commas,
     /// e.g. `sigma_s=0.05,sigma_a=0.01,g=0.3`, `sigma_s=[0.1,0.1,0.2]` or
     /// `type="height",sigma_s=0.2,falloff=0.5`; `none` for no medium.
     #[arg(long, value_name = "KEY=VALUE,...", value_parser = parse_medium)]

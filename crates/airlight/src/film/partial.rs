@@ -2,7 +2,7 @@
 //! written as an EXR file that `merge` adds up, and `--resume` continues.
 //!
 //! A partial file holds, for each pixel of its band of rows, the
-//! accumulator's fixed-point sums ([`PixelSum`]) losslessly as 32-bit
+//! accumulator's fixed-point sums ([`PixelSum`](super::PixelSum)) losslessly as 32-bit
 //! unsigned channels: `S<c>0`..`S<c>3` for the sum of channel c (R, G, B),
 //! lowest word first, `Q<c>0`..`Q<c>3` for the sum of squares, and `N0`,
 //! `N1` for the sample count. Text attributes in the header say what the

@@ -242,7 +242,7 @@ pub fn no_extra(_: &SurfaceHit) -> Rgb {
 /// light from every light, one sample per area light, with shadow rays. In a
 /// medium, light arriving from each light is attenuated on its way.
 /// (`batch.rs` computes the same without a medium for many rays at once,
-/// from the same [`emitted`] and [`for_each_light_term`].)
+/// from the same `emitted` and `for_each_light_term`.)
 pub fn surface_radiance(
     scene: &Scene,
     ray: &Ray,

@@ -47,10 +47,10 @@ pub struct PathTracer {
     /// the next segment's light (guide.rs): without it, segments that pass
     /// close to a point light make rare, bright pixels. On by default.
     pub guide: bool,
-    /// Stratify each pixel's samples: the camera's numbers and, at each
-    /// scattering event on a surface, the light samples and the new
-    /// direction come from the pixel's Owen-scrambled Sobol' points
-    /// ([`Bounce`]).
+    /// Stratify each pixel's samples: the camera's numbers and, at the
+    /// first two scattering events on surfaces, the light samples and the
+    /// new direction come from the pixel's Owen-scrambled Sobol' points
+    /// (`Bounce`).
     pub stratify: bool,
 }
 
