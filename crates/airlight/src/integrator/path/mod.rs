@@ -118,18 +118,21 @@ pub(super) struct Bounce {
 }
 
 /// Where light scatters: a surface or a point in the medium (with its
-/// place on an equiangularly sampled segment, if any).
+/// place on an equiangularly sampled segment, if any); `wo` points back
+/// along the path, toward where the light will go.
 enum Vertex<'a> {
     /// `material` as it is at the hit (a texture looked up);
     /// `light_numbers`, if stratified, the light samples' numbers.
     Surface {
         p: Vec3,
         n: Vec3,
+        wo: Vec3,
         material: &'a Material,
         light_numbers: Option<Vec2>,
     },
     Medium {
         p: Vec3,
+        wo: Vec3,
         along: Option<Along<'a>>,
     },
 }
@@ -138,6 +141,12 @@ impl Vertex<'_> {
     fn p(&self) -> Vec3 {
         match *self {
             Vertex::Surface { p, .. } | Vertex::Medium { p, .. } => p,
+        }
+    }
+
+    fn wo(&self) -> Vec3 {
+        match *self {
+            Vertex::Surface { wo, .. } | Vertex::Medium { wo, .. } => wo,
         }
     }
 }
@@ -218,9 +227,9 @@ impl Integrator for PathTracer {
                         let p = ray.at(c.t);
                         let wo = -ray.dir;
                         let guide = if self.guides(Some(m), depth) { Guide::at(scene, p) } else { None };
-                        let vertex = Vertex::Medium { p, along };
+                        let vertex = Vertex::Medium { p, wo, along };
                         let fog = Fog { medium: Some(m), closed_form: self.closed_form };
-                        l += beta * direct_light(scene, fog, &vertex, wo, r_u, hero, guide.as_ref(), sampler);
+                        l += beta * direct_light(scene, fog, &vertex, r_u, hero, guide.as_ref(), sampler);
                         let (wi, phase) = match guided(guide.as_ref(), sampler) {
                             Some((guide, choice)) => {
                                 let wi = guide.sample(choice, direction);
@@ -313,10 +322,10 @@ impl Integrator for PathTracer {
             let material = scene.material_at(&surface);
             let wo = -ray.dir;
             let vertex =
-                Vertex::Surface { p: surface.p, n: surface.n, material: &material, light_numbers: numbers.light };
+                Vertex::Surface { p: surface.p, n: surface.n, wo, material: &material, light_numbers: numbers.light };
             let fog = Fog { medium, closed_form: self.closed_form };
             let guide = if self.guides(medium, depth) { Guide::at(scene, surface.p) } else { None };
-            l += beta * direct_light(scene, fog, &vertex, wo, r_u, hero, guide.as_ref(), sampler);
+            l += beta * direct_light(scene, fog, &vertex, r_u, hero, guide.as_ref(), sampler);
             let (wi, f, pdf) = match guided(guide.as_ref(), sampler) {
                 Some((guide, choice)) => {
                     let wi = guide.sample(choice, numbers.direction);

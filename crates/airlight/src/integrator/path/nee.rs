@@ -179,18 +179,16 @@ const LIGHT_SHIFT_KEY: u64 = 0x5bd1_e995_9e37_79b9;
 /// toward which the vertex's new direction may also be drawn (guide.rs),
 /// whose density enters the heuristic. Returns the contribution to be
 /// multiplied by the path weight β.
-#[allow(clippy::too_many_arguments)]
 pub(super) fn direct_light(
     scene: &Scene,
     fog: Fog,
     vertex: &Vertex,
-    wo: Vec3,
     r_p: Rgb,
     hero: usize,
     guide: Option<&Guide>,
     sampler: &mut Sampler,
 ) -> Rgb {
-    let p = vertex.p();
+    let (p, wo) = (vertex.p(), vertex.wo());
     let stratified = match *vertex {
         Vertex::Surface { light_numbers, .. } => light_numbers,
         Vertex::Medium { .. } => None,
