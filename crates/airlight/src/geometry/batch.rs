@@ -283,16 +283,18 @@ impl Geometry {
             for (s, lanes) in groups::<L>(rays) {
                 let (hit, t) = p.triangle_lanes::<L>(s, triangle);
                 let tmax = L::load(&p.tmax[s..]);
-                let candidates = hit & lanes & (t.lt(tmax) | t.eq(tmax));
-                if candidates == 0 {
-                    continue;
-                }
-                let t = t.to_array();
-                for lane in bits(candidates as u64) {
-                    let k = s + lane;
-                    if comes_before(t[lane], i, p.tmax[k], p.id[k]) {
-                        (p.tmax[k], p.id[k]) = (t[lane], i);
+                let found = hit & lanes;
+                // `comes_before`: nearer, or as near and a lower index.
+                let mut nearer = found & t.lt(tmax);
+                let ties = found & t.eq(tmax);
+                for lane in bits(ties as u64) {
+                    if i < p.id[s + lane] {
+                        nearer |= 1 << lane;
                     }
+                }
+                if nearer != 0 {
+                    t.store_where(nearer, &mut p.tmax[s..]);
+                    L::fill_where(nearer, i, &mut p.id[s..]);
                 }
             }
         }

@@ -36,6 +36,30 @@ pub trait Lanes: Copy {
     fn lt(self, o: Self) -> u32;
     fn le(self, o: Self) -> u32;
     fn eq(self, o: Self) -> u32;
+
+    /// Writes lane i to `out[i]` where bit i of `mask` is set, leaving the
+    /// rest of `out[..WIDTH]` as it is.
+    #[inline(always)]
+    fn store_where(self, mask: u32, out: &mut [f32]) {
+        let lanes = self.to_array();
+        let mut m = mask;
+        while m != 0 {
+            let i = m.trailing_zeros() as usize;
+            m &= m - 1;
+            out[i] = lanes[i];
+        }
+    }
+
+    /// Writes `value` to `out[i]` where bit i of `mask` is set.
+    #[inline(always)]
+    fn fill_where(mask: u32, value: u32, out: &mut [u32]) {
+        let mut m = mask;
+        while m != 0 {
+            let i = m.trailing_zeros() as usize;
+            m &= m - 1;
+            out[i] = value;
+        }
+    }
 }
 
 /// The portable lanes: a loop over four f32s.
@@ -365,6 +389,19 @@ mod x86 {
         fn eq(self, o: Self) -> u32 {
             unsafe { _mm512_cmp_ps_mask::<_CMP_EQ_OQ>(self.0, o.0) as u32 }
         }
+        // Masked stores: one instruction, where the default spills the lanes
+        // and writes them back one by one. The slices are checked to hold
+        // sixteen; masked-off lanes are neither read nor written.
+        #[inline(always)]
+        fn store_where(self, mask: u32, out: &mut [f32]) {
+            let out = &mut out[..16];
+            unsafe { _mm512_mask_storeu_ps(out.as_mut_ptr(), mask as u16, self.0) }
+        }
+        #[inline(always)]
+        fn fill_where(mask: u32, value: u32, out: &mut [u32]) {
+            let out = &mut out[..16];
+            unsafe { _mm512_mask_storeu_epi32(out.as_mut_ptr().cast(), mask as u16, _mm512_set1_epi32(value as i32)) }
+        }
     }
 }
 
@@ -424,6 +461,7 @@ mod tests {
     /// [`VALUES`], bit for bit.
     fn same_as_scalar<L: Lanes>() {
         let bits = |v: &[f32]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        let lane_bits = ((1u64 << L::WIDTH) - 1) as u32;
         for (i, &a) in VALUES.iter().enumerate() {
             // Each lane a different b (of the first eight): a rotation of the values.
             let b: [f32; 16] = std::array::from_fn(|k| VALUES[(i + k) % 8]);
@@ -451,6 +489,22 @@ mod tests {
             }
             assert_eq!(bits(y.abs().to_array().as_ref()), bits(&b.map(f32::abs)[..L::WIDTH]));
             assert_eq!(x.lt(y) >> L::WIDTH, 0, "no bits past the lanes");
+            // Masked stores: the mask's lanes written, every other slot kept.
+            for mask in [0u32, 1, 0b1010_0101_1100_0011, u32::MAX] {
+                let mask = mask & lane_bits;
+                let (mut out, mut ids) = ([7.0f32; 16], [9u32; 16]);
+                y.store_where(mask, &mut out);
+                L::fill_where(mask, 3, &mut ids);
+                for k in 0..16 {
+                    let on = mask >> k & 1 == 1;
+                    assert_eq!(
+                        out[k].to_bits(),
+                        if on { b[k] } else { 7.0 }.to_bits(),
+                        "store, lane {k}, mask {mask:b}"
+                    );
+                    assert_eq!(ids[k], if on { 3 } else { 9 }, "fill, lane {k}, mask {mask:b}");
+                }
+            }
         }
     }
 
