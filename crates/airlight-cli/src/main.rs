@@ -191,7 +191,7 @@ fn gi(args: GiArgs) -> Result<(), String> {
     s.validate()?;
     if let Some(dir) = &args.output_dir {
         outputs::check_folder("--output-dir", dir)?;
-        preflight::render_memory(&scene, false)?;
+        preflight::render_memory(&scene, airlight::memory::RenderFilm::Image)?;
     }
     preflight::warn_if_dark(&scene, true);
     let pool = rayon::ThreadPoolBuilder::new()

@@ -4,6 +4,7 @@
 
 use airlight::Image;
 use airlight::integrator::Integrator;
+use airlight::memory::RenderFilm;
 use airlight::scene::Scene;
 use std::sync::Mutex;
 use std::time::{Duration, Instant};
@@ -17,11 +18,11 @@ pub const MAX_FRAMES: u32 = 1 << 20;
 pub const MAX_THREADS: u32 = 4096;
 
 /// Refuses a render whose image and sums would not fit in memory.
-pub fn render_memory(scene: &Scene, progressive: bool) -> Result<(), String> {
+pub fn render_memory(scene: &Scene, film: RenderFilm) -> Result<(), String> {
     let s = scene.settings();
     let pixels = s.width as u64 * s.height as u64;
     let what = format!("a {}×{} render", s.width, s.height);
-    airlight::memory::check(what, airlight::memory::render_bytes(pixels, progressive))
+    airlight::memory::check(what, airlight::memory::render_bytes(pixels, film))
         .map_err(|e| format!("{e}: make the image smaller (--width, --height)"))
 }
 

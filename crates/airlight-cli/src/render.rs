@@ -15,6 +15,7 @@ use airlight::film::Image;
 use airlight::film::partial::{Partial, PartialHeader, piece};
 use airlight::integrator::analytic::LightQuadrature;
 use airlight::integrator::{Integrator, IntegratorKind, MAX_LIGHT_STEPS, MAX_STEPS, Sampling};
+use airlight::memory::RenderFilm;
 use airlight::render::{RenderObserver, accumulate, frame_time, set_time};
 use airlight::scene::{MAX_IMAGE_SIDE, MAX_SPP, Scene};
 use std::ops::Range;
@@ -214,7 +215,13 @@ pub fn render(args: RenderArgs) -> Result<(), String> {
     crate::aovs::check(&aovs, &outputs, plan.partial, desc.kind)?;
     let (files, variance) = (scene.files(), args.variance.as_deref());
     crate::outputs::check_render(args.scene.as_deref(), files, &outputs, variance, args.frames)?;
-    crate::preflight::render_memory(&scene, progressive)?;
+    // As the frames below are rendered: a part first, then passes.
+    let film = match (plan.partial, progressive) {
+        (true, _) => RenderFilm::Sums,
+        (false, true) => RenderFilm::Progressive,
+        (false, false) => RenderFilm::Image,
+    };
+    crate::preflight::render_memory(&scene, film)?;
     crate::preflight::warn_if_dark(&scene, desc.kind != IntegratorKind::Direct);
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(args.threads.unwrap_or(0) as usize)

@@ -9,7 +9,7 @@ use airlight::Rgb;
 use airlight::aov::{SurfaceAovs, surface_aovs};
 use airlight::film::PixelSum;
 use airlight::integrator::IntegratorDesc;
-use airlight::render::{RenderObserver, accumulate};
+use airlight::render::{RenderObserver, accumulate, render_samples};
 use airlight::scene::RenderSettings;
 use pyo3::exceptions::{PyImportError, PyRuntimeError};
 use pyo3::prelude::*;
@@ -153,15 +153,25 @@ fn work(job: &Job, state: &State) -> Result<Output, Failure> {
         state.done.fetch_add(n, Ordering::Relaxed);
     };
     let observer = RenderObserver { progress: Some(&count), cancel: Some(&state.cancel) };
-    let rows = 0..job.settings.height;
-    let acc = pool.install(|| accumulate(&shared.scene, integrator, job.samples.clone(), rows, &observer));
+    // Built here, off the GIL, into the buffers the arrays will own. Only a
+    // variance needs every pixel's sums kept to the end.
+    fn flat(pixels: impl Iterator<Item = Rgb>) -> Vec<f32> {
+        pixels.flat_map(|p| p.to_array()).collect()
+    }
+    let (color, variance) = if job.variance {
+        let rows = 0..job.settings.height;
+        let acc = pool.install(|| accumulate(&shared.scene, integrator, job.samples.clone(), rows, &observer));
+        let variance = flat(acc.pixels().iter().map(|p| p.variance_of_mean().as_vec3()));
+        (flat(acc.pixels().iter().map(PixelSum::mean)), Some(variance))
+    } else {
+        // (At most the scene's spp, a u32.)
+        let (first, count) = (job.samples.start, (job.samples.end - job.samples.start) as u32);
+        let image = pool.install(|| render_samples(&shared.scene, integrator, first, count, &observer));
+        (flat(image.pixels.into_iter()), None)
+    };
     if state.cancel.load(Ordering::Relaxed) {
         return Err(Failure::Cancelled);
     }
-    // Built here, off the GIL, into the buffer the array will own.
-    let rgb = |f: &dyn Fn(&PixelSum) -> Rgb| acc.pixels().iter().flat_map(|p| f(p).to_array()).collect::<Vec<f32>>();
-    let color = rgb(&PixelSum::mean);
-    let variance = job.variance.then(|| rgb(&|p| p.variance_of_mean().as_vec3()));
     // As `airlight render --aov` computes them: over the camera rays of the
     // render's own samples.
     let surface =

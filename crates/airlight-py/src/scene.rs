@@ -15,6 +15,7 @@ use airlight::SceneFile;
 use airlight::aov::Aov;
 use airlight::integrator::{Integrator, IntegratorDesc, IntegratorError, IntegratorKind};
 use airlight::light::Light;
+use airlight::memory::RenderFilm;
 use airlight::scene::{AssetPath, RenderSettings, Scene};
 use numpy::ndarray::{Array2, Array3};
 use numpy::{PyArray2, PyArray3};
@@ -443,7 +444,8 @@ impl PyScene {
             // memory is refused, a scene that can only be black is warned of.
             let pixels = settings.width as u64 * settings.height as u64;
             let what = format!("a {}×{} render", settings.width, settings.height);
-            airlight::memory::check(what, airlight::memory::render_bytes(pixels, variance))
+            let film = if variance { RenderFilm::Progressive } else { RenderFilm::Image };
+            airlight::memory::check(what, airlight::memory::render_bytes(pixels, film))
                 .map_err(|e| PyMemoryError::new_err(format!("{e}: make the image smaller (width=, height=)")))?;
             let sees_medium = desc.kind != IntegratorKind::Direct;
             if let Some(why) = &self.summary.darkness[sees_medium as usize] {

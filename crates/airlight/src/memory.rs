@@ -79,13 +79,30 @@ pub fn try_vec<T: Clone>(what: &str, n: usize, value: T) -> Result<Vec<T>, Memor
     Ok(v)
 }
 
-/// Bytes a render of `pixels` pixels holds at its peak: the accumulator,
-/// the tiles' sums being merged into it, the image and an encoded file;
-/// progressive renders keep one more accumulator and a variance image.
-pub fn render_bytes(pixels: u64, progressive: bool) -> u64 {
+/// How a render keeps its pixels, which sets its memory ([`render_bytes`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RenderFilm {
+    /// All samples in one go (`render::render`): each tile's sums live only
+    /// while it renders; the image and its encoded file.
+    Image,
+    /// A part of a render (`render::accumulate`): the accumulator's sums
+    /// and the partial file they are written to.
+    Sums,
+    /// Passes (`render::Progressive`): the accumulator, each pass's sums
+    /// and the checkpoint they are written to; the image, a variance image
+    /// and an encoded file.
+    Progressive,
+}
+
+/// Bytes a render of `pixels` pixels holds at its peak.
+pub fn render_bytes(pixels: u64, film: RenderFilm) -> u64 {
     let sums = crate::film::ACCUMULATOR_BYTES_PER_PIXEL as u64;
     let image = size_of::<crate::Rgb>() as u64;
-    let per_pixel = if progressive { 3 * sums + 3 * image } else { 2 * sums + 2 * image };
+    let per_pixel = match film {
+        RenderFilm::Image => 2 * image,
+        RenderFilm::Sums => 2 * sums,
+        RenderFilm::Progressive => 3 * sums + 3 * image,
+    };
     pixels.saturating_mul(per_pixel)
 }
 
