@@ -120,9 +120,25 @@ pub fn accumulate(
     rows: Range<u32>,
     observer: &RenderObserver,
 ) -> Accumulator {
-    let width = scene.settings().width;
-    let mut acc = Accumulator::band(width, scene.settings().height, rows);
-    let first_row = acc.rows().start;
+    let mut acc = Accumulator::band(scene.settings().width, scene.settings().height, rows);
+    accumulate_into(scene, integrator, samples, &mut acc, observer);
+    acc
+}
+
+/// Adds samples `samples` of every pixel that `acc` holds into it, as
+/// [`accumulate`] would into a new one and a merge after (the sums are
+/// exact, so the bits are the same). A cancelled render leaves some of the
+/// pixels with the samples and the others without. Panics if `acc` is not
+/// of the scene's image size.
+pub fn accumulate_into(
+    scene: &Scene,
+    integrator: &dyn Integrator,
+    samples: Range<u64>,
+    acc: &mut Accumulator,
+    observer: &RenderObserver,
+) {
+    let ((width, _), first_row) = (acc.size(), acc.rows().start);
+    assert_eq!(acc.size(), (scene.settings().width, scene.settings().height), "an accumulator of the scene's image");
     let per_pixel = samples.end.saturating_sub(samples.start);
     // Each tile gets its rows of the accumulator's pixels (disjoint slices)
     // and adds its samples there: no copy, no second image-sized buffer.
@@ -133,7 +149,6 @@ pub fn accumulate(
         tile_sums(scene, integrator, origin, &mut tile, samples.clone());
         observer.tile_done(&tile, per_pixel);
     });
-    acc
 }
 
 /// Cuts a band of rows of pixels, `width` to a row and the first one the
@@ -307,18 +322,29 @@ impl Progressive {
     }
 
     /// Renders the next pass and adds it in. Returns false, adding nothing,
-    /// when the observer's cancel flag stopped the pass part way (or when
-    /// everything is already done).
+    /// when the observer's cancel flag stopped the pass part way, when
+    /// everything is already done, or when the accumulator it resumed from
+    /// is not the whole of the scene's image.
     pub fn pass(&mut self, scene: &Scene, integrator: &dyn Integrator, observer: &RenderObserver) -> bool {
         let count = self.next_pass_size();
         if count == 0 {
             return false;
         }
-        let first = self.done as u64;
-        let rows = 0..scene.settings().height;
-        let pass = accumulate(scene, integrator, first..first + count as u64, rows, observer);
-        if observer.cancelled() || self.accumulator.merge(&pass).is_err() {
+        let s = scene.settings();
+        if self.accumulator.size() != (s.width, s.height) || self.accumulator.rows() != (0..s.height) {
             return false;
+        }
+        let first = self.done as u64;
+        let samples = first..first + count as u64;
+        if observer.cancel.is_none() {
+            // Nothing can stop the pass part way: straight into the sums,
+            // without a second accumulator to fault in and merge.
+            accumulate_into(scene, integrator, samples, &mut self.accumulator, observer);
+        } else {
+            let pass = accumulate(scene, integrator, samples, 0..s.height, observer);
+            if observer.cancelled() || self.accumulator.merge(&pass).is_err() {
+                return false;
+            }
         }
         self.done += count;
         true
