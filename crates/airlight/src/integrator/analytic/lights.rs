@@ -47,6 +47,32 @@ pub(super) enum Extended {
     },
 }
 
+/// The part of a view ray that the glow is integrated over: o + t·d (d a
+/// unit vector), t in [0, t_end].
+#[derive(Clone, Copy, Debug)]
+pub(super) struct ViewSegment {
+    pub o: DVec3,
+    pub d: DVec3,
+    pub t_end: f64,
+}
+
+/// What a piece of a line, quad or triangle light emits: its share of the
+/// light's intensity (W/sr), and which light it is part of.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Share {
+    pub intensity: DVec3,
+    pub light: u32,
+}
+
+/// A sphere light as [`Extended::Sphere`] holds it.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct SphereLight {
+    pub center: DVec3,
+    pub radius: f64,
+    pub radiance: DVec3,
+    pub light: u32,
+}
+
 impl Extended {
     pub(super) fn intensity(&self) -> DVec3 {
         match *self {
@@ -86,20 +112,11 @@ impl Analytic {
     /// below about 1e-6 for every n, and for the uniform rule it keeps the
     /// ray several point spacings away. A rule of n > 16 points splits
     /// log2(n/16) times fewer.
-    #[allow(clippy::too_many_arguments)]
-    fn must_split(
-        &self,
-        o: DVec3,
-        d: DVec3,
-        t_end: f64,
-        (c, half): (DVec3, f64),
-        depth: u32,
-        max: u32,
-        rule: &Rule,
-    ) -> bool {
+    fn must_split(&self, segment: &ViewSegment, (c, half): (DVec3, f64), depth: u32, max: u32, rule: &Rule) -> bool {
         if depth >= max {
             return false;
         }
+        let ViewSegment { o, d, t_end } = *segment;
         let t = d.dot(c - o).clamp(0.0, t_end);
         let gap = (o + d * t - c).length() - half;
         gap < 8.0 * half / rule.nodes.len() as f64
@@ -107,23 +124,19 @@ impl Analytic {
 
     /// The points of a piece [a, b] of a line light, split where the ray
     /// passes close (see must_split).
-    #[allow(clippy::too_many_arguments)]
     pub(super) fn line_pieces(
         &self,
-        o: DVec3,
-        d: DVec3,
-        t_end: f64,
+        segment: &ViewSegment,
         (a, b): (DVec3, DVec3),
-        intensity: DVec3,
-        light: u32,
+        Share { intensity, light }: Share,
         depth: u32,
         each: &mut dyn FnMut(&PointEmitter),
     ) {
         let half = 0.5 * (b - a).length();
-        if self.must_split(o, d, t_end, (0.5 * (a + b), half), depth, MAX_LINE_SPLITS, &self.rule) {
-            let m = 0.5 * (a + b);
-            self.line_pieces(o, d, t_end, (a, m), intensity * 0.5, light, depth + 1, each);
-            self.line_pieces(o, d, t_end, (m, b), intensity * 0.5, light, depth + 1, each);
+        if self.must_split(segment, (0.5 * (a + b), half), depth, MAX_LINE_SPLITS, &self.rule) {
+            let (m, share) = (0.5 * (a + b), Share { intensity: intensity * 0.5, light });
+            self.line_pieces(segment, (a, m), share, depth + 1, each);
+            self.line_pieces(segment, (m, b), share, depth + 1, each);
             return;
         }
         for (x, w) in self.rule.nodes.iter().zip(&self.rule.weights) {
@@ -139,24 +152,21 @@ impl Analytic {
 
     /// The points of a piece of a quad light (corner, edges), split in four
     /// where the ray passes close.
-    #[allow(clippy::too_many_arguments)]
     pub(super) fn quad_pieces(
         &self,
-        o: DVec3,
-        d: DVec3,
-        t_end: f64,
+        segment: &ViewSegment,
         (c, u, v): (DVec3, DVec3, DVec3),
         normal: DVec3,
-        intensity: DVec3,
-        light: u32,
+        Share { intensity, light }: Share,
         depth: u32,
         each: &mut dyn FnMut(&PointEmitter),
     ) {
         let half = 0.5 * (u + v).length().max((u - v).length());
-        if self.must_split(o, d, t_end, (c + 0.5 * (u + v), half), depth, MAX_QUAD_SPLITS, &self.rule) {
+        if self.must_split(segment, (c + 0.5 * (u + v), half), depth, MAX_QUAD_SPLITS, &self.rule) {
             let (hu, hv) = (0.5 * u, 0.5 * v);
+            let share = Share { intensity: intensity * 0.25, light };
             for corner in [c, c + hu, c + hv, c + hu + hv] {
-                self.quad_pieces(o, d, t_end, (corner, hu, hv), normal, intensity * 0.25, light, depth + 1, each);
+                self.quad_pieces(segment, (corner, hu, hv), normal, share, depth + 1, each);
             }
             return;
         }
@@ -185,21 +195,17 @@ impl Analytic {
     /// forward scattering looks past a shadowing box at the light, and the
     /// difference no longer cancels: 4.7× the differential test's allowance
     /// in its seed 2402.)
-    #[allow(clippy::too_many_arguments)]
     pub(super) fn sphere_light(
         &self,
-        o: DVec3,
-        d: DVec3,
-        t_end: f64,
-        (center, radius): (DVec3, f64),
-        radiance: DVec3,
-        light: u32,
+        segment: &ViewSegment,
+        sphere: &SphereLight,
         near_surface: bool,
         each: &mut dyn FnMut(&PointEmitter),
     ) {
+        let SphereLight { center, radius, radiance, light } = *sphere;
         if near_surface {
             let whole = (-1.0, 1.0, 0.0, std::f64::consts::TAU);
-            return self.sphere_pieces(o, d, t_end, (center, radius), whole, radiance, light, 0, each);
+            return self.sphere_pieces(segment, sphere, whole, 0, each);
         }
         each(&PointEmitter {
             position: center,
@@ -215,19 +221,15 @@ impl Analytic {
     /// the ray passes close. The area element is R² dz dφ (Archimedes), so
     /// the rule in (z, φ) has constant weights; each point emits as a piece
     /// of a Lambertian surface, L cos θ dA.
-    #[allow(clippy::too_many_arguments)]
     fn sphere_pieces(
         &self,
-        o: DVec3,
-        d: DVec3,
-        t_end: f64,
-        (center, radius): (DVec3, f64),
+        segment: &ViewSegment,
+        sphere: &SphereLight,
         (z0, z1, phi0, phi1): (f64, f64, f64, f64),
-        radiance: DVec3,
-        light: u32,
         depth: u32,
         each: &mut dyn FnMut(&PointEmitter),
     ) {
+        let SphereLight { center, radius, radiance, light } = *sphere;
         let on_sphere = |z: f64, phi: f64| {
             let s = (1.0 - z * z).max(0.0).sqrt();
             DVec3::new(s * phi.cos(), s * phi.sin(), z)
@@ -238,20 +240,10 @@ impl Analytic {
             .iter()
             .map(|&(z, phi)| (center + radius * on_sphere(z, phi) - middle).length())
             .fold(0.0, f64::max);
-        if self.must_split(o, d, t_end, (middle, half), depth, MAX_SPHERE_SPLITS, &self.sphere_rule) {
+        if self.must_split(segment, (middle, half), depth, MAX_SPHERE_SPLITS, &self.sphere_rule) {
             for (za, zb) in [(z0, zm), (zm, z1)] {
                 for (pa, pb) in [(phi0, phim), (phim, phi1)] {
-                    self.sphere_pieces(
-                        o,
-                        d,
-                        t_end,
-                        (center, radius),
-                        (za, zb, pa, pb),
-                        radiance,
-                        light,
-                        depth + 1,
-                        each,
-                    );
+                    self.sphere_pieces(segment, sphere, (za, zb, pa, pb), depth + 1, each);
                 }
             }
             return;
@@ -278,27 +270,24 @@ impl Analytic {
     /// (x, y) ↦ a + x(1 − y)·e₁ + x·y·e₂, whose Jacobian 2x (as a share of
     /// the area) multiplies the weights: exact for the constant, and as
     /// accurate as the square's rule for smooth kernels.
-    #[allow(clippy::too_many_arguments)]
     pub(super) fn triangle_pieces(
         &self,
-        o: DVec3,
-        d: DVec3,
-        t_end: f64,
+        segment: &ViewSegment,
         (a, e1, e2): (DVec3, DVec3, DVec3),
         normal: DVec3,
-        intensity: DVec3,
-        light: u32,
+        Share { intensity, light }: Share,
         depth: u32,
         each: &mut dyn FnMut(&PointEmitter),
     ) {
         let centre = a + (e1 + e2) / 3.0;
         let half = [a, a + e1, a + e2].iter().map(|v| (*v - centre).length()).fold(0.0, f64::max);
-        if self.must_split(o, d, t_end, (centre, half), depth, MAX_QUAD_SPLITS, &self.rule) {
+        if self.must_split(segment, (centre, half), depth, MAX_QUAD_SPLITS, &self.rule) {
             let (h1, h2) = (0.5 * e1, 0.5 * e2);
+            let share = Share { intensity: intensity * 0.25, light };
             // Three corner triangles and the middle one, turned about but
             // with the same normal ((−h₁) × (−h₂) = h₁ × h₂).
             for piece in [(a, h1, h2), (a + h1, h1, h2), (a + h2, h1, h2), (a + h1 + h2, -h1, -h2)] {
-                self.triangle_pieces(o, d, t_end, piece, normal, intensity * 0.25, light, depth + 1, each);
+                self.triangle_pieces(segment, piece, normal, share, depth + 1, each);
             }
             return;
         }

@@ -91,7 +91,7 @@ pub use quadrature::Rule;
 pub use table::{TABLE_ERROR, im_s as im_s_tabulated, sun_f_tabulated};
 
 use blockers::Blocker;
-use lights::Extended;
+use lights::{Extended, Share, SphereLight, ViewSegment};
 use modulation::MediumConsts;
 use shadows::in_intervals;
 use triangles::MeshShadows;
@@ -370,27 +370,31 @@ impl Analytic {
         thread_local! {
             static SCRATCH: std::cell::RefCell<Scratch> = std::cell::RefCell::new(Scratch::default());
         }
+        let segment = &ViewSegment { o, d, t_end };
         let run = |scratch: &mut Scratch| {
             let mut total = DVec3::ZERO;
             for e in &self.emitters {
-                total += self.emitter_light(&consts, o, d, t_end, e, scratch);
+                total += self.emitter_light(&consts, segment, e, scratch);
             }
             for x in &self.extended {
                 let mut each = |e: &PointEmitter| {
-                    total += self.emitter_light(&consts, o, d, t_end, e, scratch);
+                    total += self.emitter_light(&consts, segment, e, scratch);
                 };
                 match *x {
                     Extended::Line { start, end, intensity, light } => {
-                        self.line_pieces(o, d, t_end, (start, end), intensity, light, 0, &mut each)
+                        self.line_pieces(segment, (start, end), Share { intensity, light }, 0, &mut each)
                     }
                     Extended::Quad { corner, edge_u, edge_v, normal, intensity, light } => {
-                        self.quad_pieces(o, d, t_end, (corner, edge_u, edge_v), normal, intensity, light, 0, &mut each)
+                        let (quad, share) = ((corner, edge_u, edge_v), Share { intensity, light });
+                        self.quad_pieces(segment, quad, normal, share, 0, &mut each)
                     }
                     Extended::Triangle { a, edge_1, edge_2, normal, intensity, light } => {
-                        self.triangle_pieces(o, d, t_end, (a, edge_1, edge_2), normal, intensity, light, 0, &mut each)
+                        let (triangle, share) = ((a, edge_1, edge_2), Share { intensity, light });
+                        self.triangle_pieces(segment, triangle, normal, share, 0, &mut each)
                     }
                     Extended::Sphere { center, radius, radiance, light, near_surface } => {
-                        self.sphere_light(o, d, t_end, (center, radius), radiance, light, near_surface, &mut each)
+                        let sphere = SphereLight { center, radius, radiance, light };
+                        self.sphere_light(segment, &sphere, near_surface, &mut each)
                     }
                 }
             }
@@ -404,16 +408,8 @@ impl Analytic {
     }
 
     /// ∫ e^{−σt (t + r)} · phase · m / r² dt · I over [0, t_end], per channel.
-    #[allow(clippy::too_many_arguments)]
-    fn emitter_light(
-        &self,
-        k: &MediumConsts,
-        o: DVec3,
-        d: DVec3,
-        t_end: f64,
-        e: &PointEmitter,
-        s: &mut Scratch,
-    ) -> DVec3 {
+    fn emitter_light(&self, k: &MediumConsts, segment: &ViewSegment, e: &PointEmitter, s: &mut Scratch) -> DVec3 {
+        let ViewSegment { o, d, t_end } = *segment;
         let p = e.position;
         let first = Glow::new(k.sigma_t[0], p, o, d, t_end);
         let glows: [Glow; 3] =
@@ -475,7 +471,7 @@ impl Analytic {
             }
             let factor = match constant {
                 Some(m) => [m; 3],
-                None => self.weighted_mean(k, &glows, o, d, ta, tb, e),
+                None => self.weighted_mean(k, &glows, segment, (ta, tb), e),
             };
             for c in 0..3 {
                 let from = c.min(k.channels - 1);

@@ -2,7 +2,7 @@
 //! function, a spot's falloff, a quad light's cosine, a sphere light's
 //! near-field factor; and the medium's numbers.
 
-use super::lights::sphere_factor;
+use super::lights::{ViewSegment, sphere_factor};
 use super::{Analytic, Emission, MODULATED_POINTS, PointEmitter, quadrature};
 use crate::integrator::analytic::closed_form::Glow;
 use crate::light::spot_falloff;
@@ -47,17 +47,15 @@ impl Analytic {
     /// Σ w e(θ) m(θ) / Σ w e(θ) over [ta, tb] per channel, with e the
     /// attenuation e^{−σt (t + r)} and m = phase · emission factor, by
     /// Gauss–Legendre in θ in panels of at most π/4.
-    #[allow(clippy::too_many_arguments)]
     pub(super) fn weighted_mean(
         &self,
         k: &MediumConsts,
         glows: &[Glow; 3],
-        o: DVec3,
-        d: DVec3,
-        ta: f64,
-        tb: f64,
+        segment: &ViewSegment,
+        (ta, tb): (f64, f64),
         e: &PointEmitter,
     ) -> [f64; 3] {
+        let ViewSegment { o, d, .. } = *segment;
         let g0 = &glows[0];
         let (a, b) = (g0.angle(ta), g0.angle(tb));
         let panels = ((b - a) / FRAC_PI_4).ceil().max(1.0) as usize;
