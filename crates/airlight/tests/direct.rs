@@ -3,7 +3,7 @@
 use airlight::geometry::Ray;
 use airlight::integrator::PathOptions;
 use airlight::integrator::RaymarchOptions;
-use airlight::integrator::{Direct, Integrator};
+use airlight::integrator::{Direct, Integrator, PathTracer};
 use airlight::prelude::*;
 use airlight::render::render;
 use airlight::sampling::Sampler;
@@ -176,15 +176,16 @@ fn surfaces_see_an_area_light_at_a_slant_but_not_through_a_blocker() {
 }
 
 /// The render loop hands blocks of samples to `radiance_batch`, which the
-/// direct integrator traces as packets: every pixel's sum must be the one
-/// that tracing its samples one by one (`pixel_sum`) gives, bit for bit.
-fn batched_render_matches_samples_one_by_one(scene: &Scene) {
+/// direct integrator traces as packets (and the path tracer its camera
+/// rays): every pixel's sum must be the one that tracing its samples one by
+/// one (`pixel_sum`) gives, bit for bit.
+fn batched_render_matches_samples_one_by_one(scene: &Scene, integrator: &dyn Integrator) {
     let s = scene.settings();
-    let acc = airlight::render::accumulate(scene, &Direct, 0..s.spp as u64, 0..s.height, &RenderObserver::none());
+    let acc = airlight::render::accumulate(scene, integrator, 0..s.spp as u64, 0..s.height, &RenderObserver::none());
     let mut lit = 0;
     for y in 0..s.height {
         for x in 0..s.width {
-            let one_by_one = airlight::render::pixel_sum(scene, &Direct, x, y, 0..s.spp as u64);
+            let one_by_one = airlight::render::pixel_sum(scene, integrator, x, y, 0..s.spp as u64);
             assert_eq!(acc.pixel(x, y), Some(&one_by_one), "pixel ({x}, {y})");
             lit += (one_by_one.mean().max_element() > 0.0) as u32;
         }
@@ -196,14 +197,17 @@ fn batched_render_matches_samples_one_by_one(scene: &Scene) {
 fn packets_of_samples_give_the_one_by_one_image() {
     // Four lights of three kinds (quad, sphere, spot) and partial blocks
     // (37×23 is no multiple of 8).
-    batched_render_matches_samples_one_by_one(&busy_scene());
-    // Meshes, boxes and quads that share edges and faces; area lights.
+    batched_render_matches_samples_one_by_one(&busy_scene(), &Direct);
+    // Meshes, boxes and quads that share edges and faces; area lights; the
+    // lamp room's fog for the path tracer.
+    let path_tracer = PathTracer::new(PathOptions { max_depth: 3, stratify: true });
     for name in ["gltf_lamp_room_fog.toml", "compare_cornell.toml"] {
         let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes").join(name);
         let mut scene = airlight::SceneFile::load(&path).expect("scene loads").scene;
         scene.settings_mut().width = 61;
         scene.settings_mut().height = 45;
         scene.settings_mut().spp = 2;
-        batched_render_matches_samples_one_by_one(&scene);
+        batched_render_matches_samples_one_by_one(&scene, &Direct);
+        batched_render_matches_samples_one_by_one(&scene, &path_tracer);
     }
 }

@@ -16,7 +16,7 @@ pub mod tracking;
 
 use super::{Integrator, PathOptions};
 use crate::Rgb;
-use crate::geometry::{Ray, offset_origin};
+use crate::geometry::{Hit, Ray, offset_origin};
 use crate::material::Material;
 use crate::medium::Medium;
 use crate::medium::{henyey_greenstein, sample_henyey_greenstein_cos};
@@ -161,6 +161,30 @@ impl Integrator for PathTracer {
     }
 
     fn radiance(&self, scene: &Scene, camera_ray: &Ray, sampler: &mut Sampler) -> Rgb {
+        self.trace(scene, camera_ray, None, sampler)
+    }
+
+    /// The camera rays' first hits found together as packets (bit for bit
+    /// the one-ray query's), then each path traced on from its hit.
+    fn radiance_batch(&self, scene: &Scene, rays: &[Ray], samplers: &mut [Sampler], out: &mut [Rgb]) {
+        let mut hits = vec![None; rays.len()];
+        scene.geometry().intersect_packet(rays, f32::INFINITY, &mut hits);
+        for (((ray, hit), sampler), out) in rays.iter().zip(hits).zip(samplers.iter_mut()).zip(out.iter_mut()) {
+            *out = self.trace(scene, ray, Some(hit), sampler);
+        }
+    }
+}
+
+impl PathTracer {
+    /// The path from `camera_ray`, whose nearest hit is `camera_hit` when
+    /// the caller has found it already.
+    fn trace(
+        &self,
+        scene: &Scene,
+        camera_ray: &Ray,
+        mut camera_hit: Option<Option<Hit>>,
+        sampler: &mut Sampler,
+    ) -> Rgb {
         let medium = scene.medium();
         let max_distance = scene.settings().max_distance;
         let hero = ((sampler.next() * 3.0) as usize).min(2);
@@ -178,7 +202,7 @@ impl Integrator for PathTracer {
         // left: a pixel at 2470 where its median is 0.15.)
         let mut roulette_pending = false;
         loop {
-            let hit = scene.geometry().intersect(&ray, f32::INFINITY);
+            let hit = camera_hit.take().unwrap_or_else(|| scene.geometry().intersect(&ray, f32::INFINITY));
             let t_hit = hit.map_or(f32::INFINITY, |h| h.t);
             if let Some(m) = medium {
                 // The medium scatters within max_distance along a ray (as the
