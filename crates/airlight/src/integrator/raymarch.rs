@@ -101,7 +101,8 @@ pub fn in_scattered(
         let t = a + offset * dt;
         let p = ray.at(t);
         let tau = medium.optical_depth(ray.origin, ray.dir, a, a + dt);
-        let weight = segment_weight(tau, dt);
+        let decay = DVec3::new((-tau.x as f64).exp(), (-tau.y as f64).exp(), (-tau.z as f64).exp());
+        let weight = segment_weight(tau, decay, dt);
         let mut light_in = Rgb::ZERO;
         let key = sampler.next_key();
         scene.for_each_light_at(p, |index, _| {
@@ -115,16 +116,46 @@ pub fn in_scattered(
             light_in += sample.weight * phase * medium.transmittance(p, sample.wi, 0.0, distance);
         });
         total += to_eye * (medium.sigma_s * medium.density_at(p) * weight * light_in).as_dvec3();
-        to_eye *= DVec3::new((-tau.x as f64).exp(), (-tau.y as f64).exp(), (-tau.z as f64).exp());
+        to_eye *= decay;
     }
     total.as_vec3()
 }
 
-/// ∫0^Δ e^{−τ s/Δ} ds = Δ(1 − e^{−τ})/τ per channel, → Δ as τ → 0.
+/// ∫0^Δ e^{−τ s/Δ} ds = Δ(1 − e^{−τ})/τ per channel, → Δ as τ → 0, from
+/// `decay` = e^{−τ} in f64, which the march needs anyway for the
+/// transmittance to the eye. In f64 the difference 1 − e^{−τ} loses
+/// log10(1/τ) of its 16 digits, at most 5 for τ ≥ 10⁻⁵, and keeps far more
+/// than f32's 7; below 10⁻⁵ the series' first two terms are exact to f32.
+/// (libm's `expm1f`, three calls a step, was a quarter of the demo scene's
+/// time.)
 #[inline]
-pub fn segment_weight(tau: Rgb, dt: f32) -> Rgb {
-    let w = |x: f32| {
-        if x < 1e-5 { dt * (1.0 - 0.5 * x) } else { dt * -(-x).exp_m1() / x }
+pub fn segment_weight(tau: Rgb, decay: DVec3, dt: f32) -> Rgb {
+    let w = |x: f32, e: f64| {
+        if x < 1e-5 { dt * (1.0 - 0.5 * x) } else { (dt as f64 * (1.0 - e) / x as f64) as f32 }
     };
-    Rgb::new(w(tau.x), w(tau.y), w(tau.z))
+    Rgb::new(w(tau.x, decay.x), w(tau.y, decay.y), w(tau.z, decay.z))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Against Δ(1 − e^{−τ})/τ in f64 through `expm1` (exact to f64 for
+    /// every τ): within an f32 rounding, on both sides of the series'
+    /// threshold and from optically thin to thick.
+    #[test]
+    fn segment_weight_is_the_integral_of_the_step_transmittance() {
+        let dt = 0.37f32;
+        for x in [0.0f32, 1e-9, 3e-7, 9.99e-6, 1e-5, 1.01e-5, 1e-4, 3e-3, 0.1, 0.7, 1.0, 4.0, 30.0, 200.0] {
+            let tau = Rgb::new(x, 2.0 * x, 0.5 * x);
+            let decay = DVec3::new((-tau.x as f64).exp(), (-tau.y as f64).exp(), (-tau.z as f64).exp());
+            let got = segment_weight(tau, decay, dt);
+            for c in 0..3 {
+                let t = tau[c] as f64;
+                let exact = if t == 0.0 { dt as f64 } else { dt as f64 * -(-t).exp_m1() / t };
+                let error = (got[c] as f64 - exact).abs() / exact;
+                assert!(error < 1.2e-7, "τ = {t:e}: {} against {exact}, relative error {error:e}", got[c]);
+            }
+        }
+    }
 }
