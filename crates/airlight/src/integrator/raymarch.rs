@@ -96,13 +96,20 @@ pub fn in_scattered(
         to_eye = medium.transmittance(ray.origin, ray.dir, 0.0, start).as_dvec3();
     }
     let mut total = DVec3::ZERO;
+    // A step's optical depth is often the last one's, to the bit (in a
+    // homogeneous medium it differs only by the rounding of the step's
+    // ends): its exponentials are then the last ones'.
+    let (mut last_tau, mut decay, mut weight) = (Rgb::NAN, DVec3::ONE, Rgb::ZERO);
     for i in 0..steps {
         let a = start + i as f32 * dt;
         let t = a + offset * dt;
         let p = ray.at(t);
         let tau = medium.optical_depth(ray.origin, ray.dir, a, a + dt);
-        let decay = DVec3::new((-tau.x as f64).exp(), (-tau.y as f64).exp(), (-tau.z as f64).exp());
-        let weight = segment_weight(tau, decay, dt);
+        if tau != last_tau {
+            decay = DVec3::new((-tau.x as f64).exp(), (-tau.y as f64).exp(), (-tau.z as f64).exp());
+            weight = segment_weight(tau, decay, dt);
+            last_tau = tau;
+        }
         let mut light_in = Rgb::ZERO;
         let key = sampler.next_key();
         scene.for_each_light_at(p, |index, _| {
