@@ -215,7 +215,7 @@ fn sizes_that_do_not_fit_in_memory_are_refused_with_size_and_limit() {
         &["render", "s.toml", "--width", "4096", "--height", "4096", "--shard", "0/2", "-o", "p.exr", "-q"],
         &limit,
     );
-    refused(&out, "a 4096×4096 render needs about 3.5 GiB, more than the");
+    refused(&out, "a 4096×4096 render needs about 3.9 GiB, more than the");
     let out =
         airlight_env(d, &["render", "s.toml", "--width", "4096", "--height", "4096", "--progressive", "-q"], &limit);
     refused(&out, "a 4096×4096 render needs about 5.8 GiB, more than the");
