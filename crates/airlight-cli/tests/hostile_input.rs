@@ -209,7 +209,7 @@ fn sizes_that_do_not_fit_in_memory_are_refused_with_size_and_limit() {
     let limit = [("AIRLIGHT_MEMORY_LIMIT", "64M")];
     let out = airlight_env(d, &["render", "s.toml", "--width", "4096", "--height", "4096", "-q"], &limit);
     refused(&out, "a 4096×4096 render needs about 384.0 MiB, more than the 64.0 MiB of AIRLIGHT_MEMORY_LIMIT");
-    // A part of a render keeps every pixel's sums, and passes two sets.
+    // A part of a render keeps every pixel's sums and their file; passes more.
     let out = airlight_env(
         d,
         &["render", "s.toml", "--width", "4096", "--height", "4096", "--shard", "0/2", "-o", "p.exr", "-q"],
