@@ -8,6 +8,7 @@ use crate::Rgb;
 use crate::geometry::{Hit, Ray, Segment, offset_origin};
 use crate::sampling::Sampler;
 use crate::scene::Scene;
+use std::cell::RefCell;
 
 /// A light's contribution to one sample, counted if its shadow ray is clear.
 struct Candidate {
@@ -23,11 +24,35 @@ struct Candidate {
 /// light, or the background.
 pub fn first_surface_batch(scene: &Scene, rays: &[Ray], samplers: &mut [Sampler], out: &mut [Rgb]) {
     assert!(rays.len() == samplers.len() && rays.len() == out.len(), "one sampler and one answer per ray");
+    // Buffers reused across calls on this thread (a fresh set if nested).
+    thread_local! {
+        static SCRATCH: RefCell<Scratch> = RefCell::new(Scratch::default());
+    }
+    SCRATCH.with(|scratch| match scratch.try_borrow_mut() {
+        Ok(mut scratch) => trace_batch(scene, rays, samplers, out, &mut scratch),
+        Err(_) => trace_batch(scene, rays, samplers, out, &mut Scratch::default()),
+    })
+}
+
+/// What [`first_surface_batch`] works in.
+#[derive(Default)]
+struct Scratch {
+    hits: Vec<Option<Hit>>,
+    candidates: Vec<Candidate>,
+    order: Vec<usize>,
+    segments: Vec<Segment>,
+    blocked_sorted: Vec<bool>,
+    blocked: Vec<bool>,
+}
+
+fn trace_batch(scene: &Scene, rays: &[Ray], samplers: &mut [Sampler], out: &mut [Rgb], scratch: &mut Scratch) {
+    let Scratch { hits, candidates, order, segments, blocked_sorted, blocked } = scratch;
     let geometry = scene.geometry();
-    let mut hits: Vec<Option<Hit>> = vec![None; rays.len()];
-    geometry.intersect_packet(rays, f32::INFINITY, &mut hits);
-    let mut candidates = Vec::with_capacity(rays.len());
-    for (k, ((ray, hit), sampler)) in rays.iter().zip(&hits).zip(samplers.iter_mut()).enumerate() {
+    hits.clear();
+    hits.resize(rays.len(), None);
+    geometry.intersect_packet(rays, f32::INFINITY, hits);
+    candidates.clear();
+    for (k, ((ray, hit), sampler)) in rays.iter().zip(hits.iter()).zip(samplers.iter_mut()).enumerate() {
         let Some(hit) = *hit else {
             out[k] = scene.settings().background;
             continue;
@@ -47,13 +72,17 @@ pub fn first_surface_batch(scene: &Scene, rays: &[Ray], samplers: &mut [Sampler]
     }
     // Shadow rays toward one light after another, each light's in the
     // samples' order (neighbouring pixels).
-    let mut order: Vec<usize> = (0..candidates.len()).filter(|&c| candidates[c].segment.is_some()).collect();
+    order.clear();
+    order.extend((0..candidates.len()).filter(|&c| candidates[c].segment.is_some()));
     order.sort_by_key(|&c| candidates[c].light);
-    let segments: Vec<Segment> = order.iter().filter_map(|&c| candidates[c].segment).collect();
-    let mut blocked_sorted = vec![false; segments.len()];
-    geometry.occluded_packet(&segments, &mut blocked_sorted);
-    let mut blocked: Vec<bool> = candidates.iter().map(|c| c.segment.is_none()).collect();
-    for (&c, &b) in order.iter().zip(&blocked_sorted) {
+    segments.clear();
+    segments.extend(order.iter().filter_map(|&c| candidates[c].segment));
+    blocked_sorted.clear();
+    blocked_sorted.resize(segments.len(), false);
+    geometry.occluded_packet(segments, blocked_sorted);
+    blocked.clear();
+    blocked.extend(candidates.iter().map(|c| c.segment.is_none()));
+    for (&c, &b) in order.iter().zip(blocked_sorted.iter()) {
         blocked[c] = b;
     }
     // Each sample's lights in index order, as `surface_radiance` adds them.
