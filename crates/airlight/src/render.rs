@@ -1,7 +1,9 @@
 //! Rendering an image: tiles over threads (rayon), each sample with its own
-//! random stream, every sample added into one [`Accumulator`], so the image
-//! is the same, bit for bit, whatever the thread count and however the
-//! samples were grouped (one render, progressive passes, shards).
+//! random stream, every sample added into exact per-pixel sums
+//! ([`PixelSum`]: a tile's own while it renders, or an [`Accumulator`]'s),
+//! so the image is the same, bit for bit, whatever the thread count and
+//! however the samples were grouped (one render, progressive passes,
+//! shards).
 
 use crate::Rgb;
 use crate::camera::CameraRays;
