@@ -7,7 +7,7 @@ use airlight::film::{Accumulator, Image, PixelSum};
 use airlight::integrator::{Integrator, IntegratorDesc, IntegratorKind};
 use airlight::preview::{Fill, FirstSample, Preview};
 use airlight::radiosity::Radiosity;
-use airlight::render::{RenderObserver, accumulate};
+use airlight::render::{RenderObserver, accumulate_into};
 use airlight::{Camera, Scene, SceneFile, light::Light};
 use rayon::prelude::*;
 use std::time::{Duration, Instant};
@@ -98,6 +98,16 @@ enum Samples {
     None,
     First(Image, Fill),
     Sums(Accumulator),
+}
+
+/// The samples so far as sums of a `width`×`height` image, taken out of
+/// `samples` (a size change, or no samples yet, starts from none).
+fn take_sums(samples: &mut Samples, (width, height): (u32, u32)) -> Accumulator {
+    match std::mem::replace(samples, Samples::None) {
+        Samples::Sums(sums) if sums.size() == (width, height) => sums,
+        Samples::First(image, _) if (image.width, image.height) == (width, height) => sums_of(&image),
+        _ => Accumulator::new(width, height),
+    }
 }
 
 /// The sums of a one-sample image, as the renderer's accumulator holds them.
@@ -225,7 +235,9 @@ impl Engine {
         let count = self.samples.max(1).min(self.batch.max(1)).min(self.max_spp.saturating_sub(self.samples));
         if count > 0 {
             let t = Instant::now();
-            let pass = match self.mode {
+            let size = self.size();
+            let mut sums = take_sums(&mut self.accumulator, size);
+            match self.mode {
                 Mode::Preview => {
                     let preview = Preview::new(
                         &self.scene,
@@ -246,7 +258,7 @@ impl Engine {
                         stats.samples = 1;
                         return stats;
                     }
-                    self.accumulate(&preview, count)
+                    self.add_samples(&preview, count, &mut sums);
                 }
                 Mode::Raymarch | Mode::Stochastic => {
                     let kind =
@@ -254,20 +266,10 @@ impl Engine {
                     // Progressive refinement wants jittered march samples.
                     let mut desc = self.integrators.with_kind(kind);
                     desc.raymarch.jitter = true;
-                    match desc.build(&self.scene) {
-                        Ok(integrator) => self.accumulate(integrator.as_ref(), count),
-                        Err(_) => Accumulator::new(self.size().0, self.size().1),
+                    if let Ok(integrator) = desc.build(&self.scene) {
+                        self.add_samples(integrator.as_ref(), count, &mut sums);
                     }
                 }
-            };
-            let mut sums = match std::mem::replace(&mut self.accumulator, Samples::None) {
-                Samples::Sums(sums) => sums,
-                Samples::First(image, _) => sums_of(&image),
-                Samples::None => Accumulator::new(0, 0),
-            };
-            // A size change (or no samples yet) starts from this pass alone.
-            if sums.merge(&pass).is_err() {
-                sums = pass;
             }
             self.accumulator = Samples::Sums(sums);
             self.samples += count;
@@ -283,9 +285,11 @@ impl Engine {
         Preview::new(&self.scene, self.solution.as_ref(), self.integrators.analytic, self.integrators.raymarch)
     }
 
-    fn accumulate(&self, integrator: &dyn Integrator, count: u32) -> Accumulator {
-        let (first, rows) = (self.samples as u64, 0..self.size().1);
-        accumulate(&self.scene, integrator, first..first + count as u64, rows, &RenderObserver::none())
+    /// Adds the next `count` samples of every pixel into `sums`, in place:
+    /// no pass-sized accumulator to fault in and merge each frame.
+    fn add_samples(&self, integrator: &dyn Integrator, count: u32, sums: &mut Accumulator) {
+        let first = self.samples as u64;
+        accumulate_into(&self.scene, integrator, first..first + count as u64, sums, &RenderObserver::none());
     }
 
     /// The running mean at the current render size (black before the
