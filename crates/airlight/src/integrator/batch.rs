@@ -45,6 +45,7 @@ struct Scratch {
     blocked: Vec<bool>,
 }
 
+/// [`first_surface_batch`] in `scratch`'s buffers.
 fn trace_batch(scene: &Scene, rays: &[Ray], samplers: &mut [Sampler], out: &mut [Rgb], scratch: &mut Scratch) {
     let Scratch { hits, candidates, order, segments, blocked_sorted, blocked } = scratch;
     let geometry = scene.geometry();
