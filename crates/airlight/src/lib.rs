@@ -43,6 +43,7 @@ pub mod render;
 pub mod sampling;
 pub mod scene;
 mod scene_file;
+mod scratch;
 pub mod texture;
 
 /// Linear RGB radiance, irradiance or reflectance.

@@ -58,13 +58,6 @@ impl RenderObserver<'_> {
     fn cancelled(&self) -> bool {
         self.cancel.is_some_and(|c| c.load(Ordering::Relaxed))
     }
-
-    /// Reports a finished tile of `rows` with `per_pixel` samples each.
-    fn tile_done(&self, rows: &[&mut [PixelSum]], per_pixel: u64) {
-        if let Some(progress) = self.progress {
-            progress(rows.iter().map(|row| row.len() as u64).sum::<u64>() * per_pixel);
-        }
-    }
 }
 
 /// Renders the scene's `spp` samples of every pixel with `integrator`: each
@@ -82,8 +75,8 @@ pub fn render(scene: &Scene, integrator: &dyn Integrator, observer: &RenderObser
 /// tile's size, and leave as the tile's means: the image-sized accumulator
 /// (112 bytes a pixel, against the image's 12) is never made. At 1024² and
 /// one sample per pixel, faulting in its fresh pages and reading it back
-/// made the image take 1.33× the time; at 3840×2160 it was 880 MB of the
-/// 1 GB the render held.
+/// made the image take 1.33× the time; at 3840×2160 it was 929 MB of the
+/// 1020 MB the render held.
 pub fn render_samples(
     scene: &Scene,
     integrator: &dyn Integrator,
@@ -94,10 +87,7 @@ pub fn render_samples(
     let s = scene.settings();
     let samples = first..first + count as u64;
     let mut image = Image::new(s.width, s.height);
-    tiles(&mut image.pixels, s.width, 0).into_par_iter().for_each(|(origin, mut means)| {
-        if observer.cancelled() {
-            return;
-        }
+    for_each_tile(&mut image.pixels, s.width, 0, count as u64, observer, |origin, means| {
         let tile_width = means.first().map_or(0, |row| row.len());
         let mut sums = vec![PixelSum::default(); tile_width * means.len()];
         let mut sum_rows: TileRows = sums.chunks_mut(tile_width.max(1)).collect();
@@ -107,7 +97,6 @@ pub fn render_samples(
                 *mean = sum.mean();
             }
         }
-        observer.tile_done(&sum_rows, count as u64);
     });
     image
 }
@@ -149,12 +138,31 @@ pub fn accumulate_into(
     let per_pixel = samples.end.saturating_sub(samples.start);
     // Each tile gets its rows of the accumulator's pixels (disjoint slices)
     // and adds its samples there: no copy, no second image-sized buffer.
-    tiles(acc.pixels_mut(), width, first_row).into_par_iter().for_each(|(origin, mut tile)| {
+    for_each_tile(acc.pixels_mut(), width, first_row, per_pixel, observer, |origin, tile| {
+        tile_sums(scene, integrator, origin, tile, samples.clone());
+    });
+}
+
+/// Runs `work(origin, rows)` on every tile of `pixels` ([`tiles`]) over the
+/// threads, each tile once; tiles not started when the observer's cancel
+/// flag is set are skipped. Each finished tile is reported to the observer
+/// as its pixels times `per_pixel` samples.
+fn for_each_tile<T: Send>(
+    pixels: &mut [T],
+    width: u32,
+    first_row: u32,
+    per_pixel: u64,
+    observer: &RenderObserver,
+    work: impl Fn((u32, u32), &mut TileRows<T>) + Sync,
+) {
+    tiles(pixels, width, first_row).into_par_iter().for_each(|(origin, mut tile)| {
         if observer.cancelled() {
             return;
         }
-        tile_sums(scene, integrator, origin, &mut tile, samples.clone());
-        observer.tile_done(&tile, per_pixel);
+        work(origin, &mut tile);
+        if let Some(progress) = observer.progress {
+            progress(tile.iter().map(|row| row.len() as u64).sum::<u64>() * per_pixel);
+        }
     });
 }
 

@@ -8,6 +8,7 @@ use crate::Rgb;
 use crate::geometry::{Hit, Ray, Segment, offset_origin};
 use crate::sampling::Sampler;
 use crate::scene::Scene;
+use crate::scratch::with_scratch;
 use std::cell::RefCell;
 
 /// A light's contribution to one sample, counted if its shadow ray is clear.
@@ -24,14 +25,10 @@ struct Candidate {
 /// light, or the background.
 pub fn first_surface_batch(scene: &Scene, rays: &[Ray], samplers: &mut [Sampler], out: &mut [Rgb]) {
     assert!(rays.len() == samplers.len() && rays.len() == out.len(), "one sampler and one answer per ray");
-    // Buffers reused across calls on this thread (a fresh set if nested).
     thread_local! {
         static SCRATCH: RefCell<Scratch> = RefCell::new(Scratch::default());
     }
-    SCRATCH.with(|scratch| match scratch.try_borrow_mut() {
-        Ok(mut scratch) => trace_batch(scene, rays, samplers, out, &mut scratch),
-        Err(_) => trace_batch(scene, rays, samplers, out, &mut Scratch::default()),
-    })
+    with_scratch(&SCRATCH, |scratch| trace_batch(scene, rays, samplers, out, scratch))
 }
 
 /// What [`first_surface_batch`] works in.

@@ -419,17 +419,14 @@ impl Scene {
         thread_local! {
             static FOUND: std::cell::RefCell<Vec<u32>> = const { std::cell::RefCell::new(Vec::new()) };
         }
-        let mut visit = |found: &mut Vec<u32>| {
+        let visit = |found: &mut Vec<u32>| {
             self.light_culling.lights_at(p, found);
             for &i in found.iter() {
                 f(i as usize, &self.lights[i as usize]);
             }
         };
         // A reused buffer, or a fresh one if a caller nests these loops.
-        FOUND.with(|found| match found.try_borrow_mut() {
-            Ok(mut found) => visit(&mut found),
-            Err(_) => visit(&mut Vec::new()),
-        });
+        crate::scratch::with_scratch(&FOUND, visit);
     }
 
     /// Replaces the falloff model of every point, spot and sphere light

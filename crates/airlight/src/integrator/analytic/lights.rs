@@ -10,35 +10,29 @@ pub(super) enum Extended {
     Line {
         start: DVec3,
         end: DVec3,
-        /// intensity per unit length × length, W/sr.
-        intensity: DVec3,
-        light: u32,
+        /// Intensity per unit length × length, W/sr.
+        share: Share,
     },
     Quad {
         corner: DVec3,
         edge_u: DVec3,
         edge_v: DVec3,
         normal: DVec3,
-        /// radiance × area: the intensity along the normal, W/sr.
-        intensity: DVec3,
-        light: u32,
+        /// Radiance × area: the intensity along the normal, W/sr.
+        share: Share,
     },
     Triangle {
         a: DVec3,
         edge_1: DVec3,
         edge_2: DVec3,
         normal: DVec3,
-        /// radiance × area: the intensity along the normal, W/sr.
-        intensity: DVec3,
-        light: u32,
+        /// Radiance × area: the intensity along the normal, W/sr.
+        share: Share,
     },
     /// A sphere light: a point at its centre ([`sphere_factor`]), or points
     /// on its surface where a surface near it casts penumbrae.
     Sphere {
-        center: DVec3,
-        radius: f64,
-        radiance: DVec3,
-        light: u32,
+        sphere: SphereLight,
         /// Whether a surface that can cast a penumbra comes within
         /// [`NEAR_RADII`] radii of the sphere (with shadows): its penumbrae
         /// are then wide, and the hard shadow of a point at the centre would
@@ -56,15 +50,15 @@ pub(super) struct ViewSegment {
     pub t_end: f64,
 }
 
-/// What a piece of a line, quad or triangle light emits: its share of the
-/// light's intensity (W/sr), and which light it is part of.
+/// What a light, or a piece of a line, quad or triangle light, emits: its
+/// share of the light's intensity (W/sr), and which light it is part of.
 #[derive(Clone, Copy, Debug)]
 pub(super) struct Share {
     pub intensity: DVec3,
     pub light: u32,
 }
 
-/// A sphere light as [`Extended::Sphere`] holds it.
+/// A sphere light (centre, radius, radiance) and its index.
 #[derive(Clone, Copy, Debug)]
 pub(super) struct SphereLight {
     pub center: DVec3,
@@ -76,10 +70,10 @@ pub(super) struct SphereLight {
 impl Extended {
     pub(super) fn intensity(&self) -> DVec3 {
         match *self {
-            Extended::Line { intensity, .. }
-            | Extended::Quad { intensity, .. }
-            | Extended::Triangle { intensity, .. } => intensity,
-            Extended::Sphere { radiance, .. } => radiance,
+            Extended::Line { share, .. } | Extended::Quad { share, .. } | Extended::Triangle { share, .. } => {
+                share.intensity
+            }
+            Extended::Sphere { sphere, .. } => sphere.radiance,
         }
     }
 }

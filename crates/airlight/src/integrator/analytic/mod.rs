@@ -277,10 +277,12 @@ impl Analytic {
                         0.0,
                     )),
                 Light::Sphere { center, radius, radiance, .. } => extended.push(Extended::Sphere {
-                    center: center.as_dvec3(),
-                    radius: radius as f64,
-                    radiance: radiance.as_dvec3(),
-                    light: index,
+                    sphere: SphereLight {
+                        center: center.as_dvec3(),
+                        radius: radius as f64,
+                        radiance: radiance.as_dvec3(),
+                        light: index,
+                    },
                     // Set below, once the occluders are known.
                     near_surface: false,
                 }),
@@ -289,8 +291,7 @@ impl Analytic {
                     extended.push(Extended::Line {
                         start: a,
                         end: b,
-                        intensity: intensity.as_dvec3() * (b - a).length(),
-                        light: index,
+                        share: Share { intensity: intensity.as_dvec3() * (b - a).length(), light: index },
                     });
                 }
                 Light::Quad { corner, edge_u, edge_v, radiance } => {
@@ -302,8 +303,7 @@ impl Analytic {
                         edge_u: u,
                         edge_v: v,
                         normal: n.normalize(),
-                        intensity: radiance.as_dvec3() * n.length(),
-                        light: index,
+                        share: Share { intensity: radiance.as_dvec3() * n.length(), light: index },
                     });
                 }
                 Light::Triangle { a, edge_1, edge_2, radiance } => {
@@ -314,8 +314,7 @@ impl Analytic {
                         edge_1: e1,
                         edge_2: e2,
                         normal: n.normalize(),
-                        intensity: radiance.as_dvec3() * (0.5 * n.length()),
-                        light: index,
+                        share: Share { intensity: radiance.as_dvec3() * (0.5 * n.length()), light: index },
                     });
                 }
                 Light::Volume { .. } => {
@@ -340,8 +339,9 @@ impl Analytic {
         if options.shadows {
             clearance::check_sphere_lights(scene.lights(), &blockers, &meshes)?;
             for x in &mut extended {
-                if let Extended::Sphere { center, radius, light, near_surface, .. } = x {
-                    *near_surface = clearance::surface_near(*center, *radius, *light, &blockers, &meshes);
+                if let Extended::Sphere { sphere, near_surface } = x {
+                    *near_surface =
+                        clearance::surface_near(sphere.center, sphere.radius, sphere.light, &blockers, &meshes);
                 }
             }
         }
@@ -381,29 +381,23 @@ impl Analytic {
                     total += self.emitter_light(&consts, segment, e, scratch);
                 };
                 match *x {
-                    Extended::Line { start, end, intensity, light } => {
-                        self.line_pieces(segment, (start, end), Share { intensity, light }, 0, &mut each)
+                    Extended::Line { start, end, share } => {
+                        self.line_pieces(segment, (start, end), share, 0, &mut each)
                     }
-                    Extended::Quad { corner, edge_u, edge_v, normal, intensity, light } => {
-                        let (quad, share) = ((corner, edge_u, edge_v), Share { intensity, light });
-                        self.quad_pieces(segment, quad, normal, share, 0, &mut each)
+                    Extended::Quad { corner, edge_u, edge_v, normal, share } => {
+                        self.quad_pieces(segment, (corner, edge_u, edge_v), normal, share, 0, &mut each)
                     }
-                    Extended::Triangle { a, edge_1, edge_2, normal, intensity, light } => {
-                        let (triangle, share) = ((a, edge_1, edge_2), Share { intensity, light });
-                        self.triangle_pieces(segment, triangle, normal, share, 0, &mut each)
+                    Extended::Triangle { a, edge_1, edge_2, normal, share } => {
+                        self.triangle_pieces(segment, (a, edge_1, edge_2), normal, share, 0, &mut each)
                     }
-                    Extended::Sphere { center, radius, radiance, light, near_surface } => {
-                        let sphere = SphereLight { center, radius, radiance, light };
+                    Extended::Sphere { sphere, near_surface } => {
                         self.sphere_light(segment, &sphere, near_surface, &mut each)
                     }
                 }
             }
             total
         };
-        let total = SCRATCH.with(|s| match s.try_borrow_mut() {
-            Ok(mut s) => run(&mut s),
-            Err(_) => run(&mut Scratch::default()),
-        });
+        let total = crate::scratch::with_scratch(&SCRATCH, run);
         (total * medium.sigma_s.as_dvec3()).as_vec3()
     }
 
