@@ -5,22 +5,35 @@
 //! accumulator's fixed-point sums ([`PixelSum`](super::PixelSum)) losslessly as 32-bit
 //! unsigned channels: `S<c>0`..`S<c>3` for the sum of channel c (R, G, B),
 //! lowest word first, `Q<c>0`..`Q<c>3` for the sum of squares, and `N0`,
-//! `N1` for the sample count. Text attributes in the header say what the
-//! sums are of ([`PartialHeader`]): the Airlight version, a fingerprint of
-//! the resolved scene, the seed, the image size, the total spp, the sample
-//! range, the band of rows and the frame. Since each sample's random
+//! `N1` for the sample count. One text attribute of the header,
+//! `airlight.partial`, says in `key=value` lines what the sums are of
+//! ([`PartialHeader`]): the Airlight version, a fingerprint of the resolved
+//! scene, the seed, the image size, the total spp, the sample range, the
+//! band of rows and the frame. One attribute, not one per field: the EXR
+//! writer orders a header's attributes as its hash map iterates, which
+//! differs from process to process, and a file's bytes should not.
+//! Files of the first format (`airlight-partial-1`), with an attribute per
+//! field, are still read. Since each sample's random
 //! stream is keyed by (seed, pixel, sample number) and the sums are exact
 //! integers, parts that together hold every sample of every pixel once add
 //! up to the very sums one render makes: the merged image is the same, bit
 //! for bit.
 
 use super::Accumulator;
+use std::collections::BTreeMap;
 use std::io;
 use std::ops::Range;
 use std::path::Path;
 
 /// The format tag written in every partial file.
-pub const PARTIAL_FORMAT: &str = "airlight-partial-1";
+pub const PARTIAL_FORMAT: &str = "airlight-partial-2";
+
+/// The first format: the same fields, each in an attribute of its own
+/// named `airlight.<key>`. Read, no longer written.
+const PARTIAL_FORMAT_1: &str = "airlight-partial-1";
+
+/// The header attribute that holds a partial's fields.
+const FIELDS_ATTRIBUTE: &str = "airlight.partial";
 
 /// What a partial file's sums are of.
 #[derive(Clone, Debug, PartialEq)]
@@ -57,9 +70,17 @@ pub struct Partial {
 const CHANNELS: [char; 3] = ['R', 'G', 'B'];
 
 impl Partial {
-    /// Encodes the partial as EXR bytes (ZIP, lines in increasing order, so
-    /// the bytes are the same whatever the thread count).
+    /// Encodes the partial as EXR bytes: ZIP, lines in increasing order
+    /// and the fields in one attribute, so that the same sums and header
+    /// give the same bytes whatever the thread count and the run.
     pub fn encode(&self) -> io::Result<Vec<u8>> {
+        let fields: String =
+            header_fields(&self.header).iter().map(|(key, value)| format!("{key}={value}\n")).collect();
+        self.encode_with_attributes(&[(FIELDS_ATTRIBUTE, fields)])
+    }
+
+    /// The EXR bytes of the sums with these text attributes in the header.
+    fn encode_with_attributes(&self, text_attributes: &[(&str, String)]) -> io::Result<Vec<u8>> {
         use exr::prelude::*;
         let h = &self.header;
         let (w, rows) = (h.width as usize, (h.rows.end - h.rows.start) as usize);
@@ -82,8 +103,8 @@ impl Partial {
             list.push(AnyChannel::new(format!("N{k}").as_str(), FlatSamples::U32(count)));
         }
         let mut attributes = LayerAttributes::named("airlight-partial");
-        for (key, value) in header_fields(h) {
-            let text = Text::new_or_none(&value).ok_or_else(|| io::Error::other("non-ASCII header"))?;
+        for (key, value) in text_attributes {
+            let text = Text::new_or_none(value).ok_or_else(|| io::Error::other("non-ASCII header"))?;
             attributes.other.insert(Text::new_or_panic(key), AttributeValue::Text(text));
         }
         let encoding =
@@ -154,40 +175,70 @@ impl Partial {
     }
 }
 
+/// The header's fields as (key, value) text, in a fixed order, the format
+/// tag first.
 fn header_fields(h: &PartialHeader) -> Vec<(&'static str, String)> {
     vec![
-        ("airlight.format", PARTIAL_FORMAT.to_string()),
-        ("airlight.version", h.version.clone()),
-        ("airlight.scene", h.scene.clone()),
-        ("airlight.seed", h.seed.to_string()),
-        ("airlight.width", h.width.to_string()),
-        ("airlight.height", h.height.to_string()),
-        ("airlight.spp", h.spp.to_string()),
-        ("airlight.samples", format!("{}..{}", h.samples.start, h.samples.end)),
-        ("airlight.rows", format!("{}..{}", h.rows.start, h.rows.end)),
-        ("airlight.frame", h.frame.map_or("-".into(), |(k, n)| format!("{k}/{n}"))),
+        ("format", PARTIAL_FORMAT.to_string()),
+        ("version", h.version.clone()),
+        ("scene", h.scene.clone()),
+        ("seed", h.seed.to_string()),
+        ("width", h.width.to_string()),
+        ("height", h.height.to_string()),
+        ("spp", h.spp.to_string()),
+        ("samples", format!("{}..{}", h.samples.start, h.samples.end)),
+        ("rows", format!("{}..{}", h.rows.start, h.rows.end)),
+        ("frame", h.frame.map_or("-".into(), |(k, n)| format!("{k}/{n}"))),
         // Shortest text that reads back as the same f32.
-        ("airlight.exposure", format!("{:?}", h.exposure)),
-        ("airlight.tonemap", h.tonemap.name().to_string()),
+        ("exposure", format!("{:?}", h.exposure)),
+        ("tonemap", h.tonemap.name().to_string()),
     ]
+}
+
+/// The fields of a header's text attributes: the lines of
+/// [`FIELDS_ATTRIBUTE`], or else (the first format) the attributes named
+/// `airlight.<key>`.
+fn read_fields(
+    attributes: &std::collections::HashMap<exr::meta::attribute::Text, exr::meta::attribute::AttributeValue>,
+) -> Result<BTreeMap<String, String>, String> {
+    use exr::meta::attribute::AttributeValue;
+    let texts = attributes.iter().filter_map(|(key, value)| match value {
+        AttributeValue::Text(text) => Some((key.to_string(), text.to_string())),
+        _ => None,
+    });
+    let mut fields = BTreeMap::new();
+    let mut packed = None;
+    for (key, value) in texts {
+        if key == FIELDS_ATTRIBUTE {
+            packed = Some(value);
+        } else if let Some(field) = key.strip_prefix("airlight.") {
+            fields.insert(field.to_string(), value);
+        }
+    }
+    if let Some(lines) = packed {
+        fields.clear();
+        for line in lines.lines() {
+            let (key, value) = line
+                .split_once('=')
+                .ok_or_else(|| format!("its header's `{FIELDS_ATTRIBUTE}` has a line without `=`: `{line}`"))?;
+            fields.insert(key.to_string(), value.to_string());
+        }
+    }
+    Ok(fields)
 }
 
 fn parse_header(
     attributes: &std::collections::HashMap<exr::meta::attribute::Text, exr::meta::attribute::AttributeValue>,
 ) -> Result<PartialHeader, String> {
+    let fields = read_fields(attributes)?;
     let get = |key: &str| -> Result<String, String> {
-        attributes
-            .iter()
-            .find(|(k, _)| *k == key)
-            .and_then(|(_, v)| match v {
-                exr::meta::attribute::AttributeValue::Text(t) => Some(t.to_string()),
-                _ => None,
-            })
-            .ok_or_else(|| format!("not an Airlight partial render (no `{key}` in its header)"))
+        fields.get(key).cloned().ok_or_else(|| format!("not an Airlight partial render (no `{key}` in its header)"))
     };
-    let format = get("airlight.format")?;
-    if format != PARTIAL_FORMAT {
-        return Err(format!("a partial render of format `{format}`; this Airlight reads `{PARTIAL_FORMAT}`"));
+    let format = get("format")?;
+    if format != PARTIAL_FORMAT && format != PARTIAL_FORMAT_1 {
+        return Err(format!(
+            "a partial render of format `{format}`; this Airlight reads `{PARTIAL_FORMAT}` and `{PARTIAL_FORMAT_1}`"
+        ));
     }
     let number = |key: &str| -> Result<u64, String> {
         get(key)?.parse().map_err(|_| format!("its header's `{key}` is not a whole number"))
@@ -203,10 +254,10 @@ fn parse_header(
         Ok(a..b)
     };
     let small = |v: u64, key: &str| u32::try_from(v).map_err(|_| format!("its header's `{key}` is too large: {v}"));
-    let (width, height) = (small(number("airlight.width")?, "width")?, small(number("airlight.height")?, "height")?);
-    let spp = small(number("airlight.spp")?, "spp")?;
-    let samples = range("airlight.samples")?;
-    let rows = range("airlight.rows")?;
+    let (width, height) = (small(number("width")?, "width")?, small(number("height")?, "height")?);
+    let spp = small(number("spp")?, "spp")?;
+    let samples = range("samples")?;
+    let rows = range("rows")?;
     if samples.end > spp as u64 || rows.end > height as u64 {
         return Err(format!(
             "its header's samples {samples:?} or rows {rows:?} lie outside the image's {spp} spp or {height} rows"
@@ -218,7 +269,7 @@ fn parse_header(
             rows.end - rows.start
         ));
     }
-    let frame = match get("airlight.frame")?.as_str() {
+    let frame = match get("frame")?.as_str() {
         "-" => None,
         text => {
             let bad = || format!("its header's frame `{text}` is not k/n");
@@ -226,18 +277,18 @@ fn parse_header(
             Some((k.parse().map_err(|_| bad())?, n.parse().map_err(|_| bad())?))
         }
     };
-    let exposure = get("airlight.exposure")?
+    let exposure = get("exposure")?
         .parse::<f32>()
         .ok()
         .filter(|e| e.is_finite())
-        .ok_or("its header's `airlight.exposure` is not a finite number")?;
-    let tonemap = get("airlight.tonemap")?.parse().map_err(|e| format!("its header's `airlight.tonemap`: {e}"))?;
+        .ok_or("its header's `exposure` is not a finite number")?;
+    let tonemap = get("tonemap")?.parse().map_err(|e| format!("its header's `tonemap`: {e}"))?;
     Ok(PartialHeader {
         exposure,
         tonemap,
-        version: get("airlight.version")?,
-        scene: get("airlight.scene")?,
-        seed: number("airlight.seed")?,
+        version: get("version")?,
+        scene: get("scene")?,
+        seed: number("seed")?,
         width,
         height,
         spp,
@@ -376,6 +427,41 @@ mod tests {
         let p = part(1..3, 2..5, 7);
         p.write(&path).unwrap();
         assert_eq!(Partial::read(&path).unwrap(), p);
+    }
+
+    /// The writer orders a header's attributes as a hash map with keys
+    /// drawn per map iterates; the fields' one attribute makes the bytes
+    /// the same on every encoding.
+    #[test]
+    fn a_partial_encodes_to_the_same_bytes_every_time() {
+        let p = part(0..4, 0..5, 7);
+        let first = p.encode().unwrap();
+        for _ in 0..8 {
+            assert_eq!(p.encode().unwrap(), first);
+        }
+    }
+
+    /// A file of the first format, an attribute per field, as earlier
+    /// builds wrote them.
+    #[test]
+    fn a_partial_file_of_the_first_format_reads() {
+        let p = part(1..3, 2..5, 7);
+        let fields: Vec<(String, String)> = header_fields(&p.header)
+            .into_iter()
+            .map(|(key, value)| {
+                let value = if key == "format" { PARTIAL_FORMAT_1.to_string() } else { value };
+                (format!("airlight.{key}"), value)
+            })
+            .collect();
+        let attributes: Vec<(&str, String)> = fields.iter().map(|(k, v)| (k.as_str(), v.clone())).collect();
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("p1.exr");
+        std::fs::write(&path, p.encode_with_attributes(&attributes).unwrap()).unwrap();
+        assert_eq!(Partial::read(&path).unwrap(), p);
+        let unknown = [(FIELDS_ATTRIBUTE, "format=airlight-partial-9\n".to_string())];
+        std::fs::write(&path, p.encode_with_attributes(&unknown).unwrap()).unwrap();
+        let e = Partial::read(&path).unwrap_err();
+        assert!(e.contains("of format `airlight-partial-9`"), "{e}");
     }
 
     #[test]
