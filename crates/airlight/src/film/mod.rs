@@ -9,6 +9,7 @@ mod compare;
 pub mod partial;
 
 pub use accumulator::{ACCUMULATOR_BYTES_PER_PIXEL, Accumulator, PixelSum, SQUARE_FRACTION_BITS, SUM_FRACTION_BITS};
+pub(crate) use accumulator::{AddSample, PixelTotal};
 pub use compare::{ImageError, compare, error_map};
 pub use partial::{Partial, PartialHeader};
 
