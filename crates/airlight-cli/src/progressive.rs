@@ -5,7 +5,7 @@
 use crate::progress::Progress;
 use crate::render::{FrameOutputs, Run, format_error, write_images};
 use crate::timing::Timing;
-use airlight::film::partial::{Partial, PartialHeader};
+use airlight::film::partial::{self, Partial, PartialHeader};
 use airlight::render::{Progressive, RenderObserver};
 use airlight::scene::Scene;
 use std::path::{Path, PathBuf};
@@ -102,8 +102,8 @@ pub(crate) fn render_progressive(
                 variance.save(path).map_err(|e| format!("cannot write `{}`: {e}", path.display()))?;
             }
             let header = PartialHeader { samples: 0..progressive.samples() as u64, ..state.header.clone() };
-            Partial { header, sums: progressive.accumulator().clone() }
-                .write(&state.path)
+            // The running sums themselves, not a copy (112 bytes a pixel).
+            partial::write(&state.path, &header, progressive.accumulator())
                 .map_err(|e| format!("cannot write `{}`: {e}", state.path.display()))
         })?;
     }

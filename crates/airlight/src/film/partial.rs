@@ -19,7 +19,7 @@
 //! up to the very sums one render makes: the merged image is the same, bit
 //! for bit.
 
-use super::Accumulator;
+use super::{Accumulator, PixelSum};
 use std::collections::BTreeMap;
 use std::io;
 use std::ops::Range;
@@ -70,54 +70,14 @@ pub struct Partial {
 const CHANNELS: [char; 3] = ['R', 'G', 'B'];
 
 impl Partial {
-    /// Encodes the partial as EXR bytes: ZIP, lines in increasing order
-    /// and the fields in one attribute, so that the same sums and header
-    /// give the same bytes whatever the thread count and the run.
+    /// Encodes the partial as EXR bytes: see [`encode`].
     pub fn encode(&self) -> io::Result<Vec<u8>> {
-        let fields: String =
-            header_fields(&self.header).iter().map(|(key, value)| format!("{key}={value}\n")).collect();
-        self.encode_with_attributes(&[(FIELDS_ATTRIBUTE, fields)])
-    }
-
-    /// The EXR bytes of the sums with these text attributes in the header.
-    fn encode_with_attributes(&self, text_attributes: &[(&str, String)]) -> io::Result<Vec<u8>> {
-        use exr::prelude::*;
-        let h = &self.header;
-        let (w, rows) = (h.width as usize, (h.rows.end - h.rows.start) as usize);
-        let pixels = self.sums.pixels();
-        if pixels.len() != w * rows {
-            return Err(io::Error::other("partial sums do not match their header's size"));
-        }
-        let word = |v: i128, k: u32| (v as u128 >> (32 * k)) as u32;
-        let mut list = Vec::new();
-        for (c, name) in CHANNELS.iter().enumerate() {
-            for k in 0..4 {
-                let sum = pixels.iter().map(|p| word(p.sum[c], k)).collect();
-                list.push(AnyChannel::new(format!("S{name}{k}").as_str(), FlatSamples::U32(sum)));
-                let squares = pixels.iter().map(|p| word(p.sum_squares[c], k)).collect();
-                list.push(AnyChannel::new(format!("Q{name}{k}").as_str(), FlatSamples::U32(squares)));
-            }
-        }
-        for k in 0..2 {
-            let count = pixels.iter().map(|p| (p.count >> (32 * k)) as u32).collect();
-            list.push(AnyChannel::new(format!("N{k}").as_str(), FlatSamples::U32(count)));
-        }
-        let mut attributes = LayerAttributes::named("airlight-partial");
-        for (key, value) in text_attributes {
-            let text = Text::new_or_none(value).ok_or_else(|| io::Error::other("non-ASCII header"))?;
-            attributes.other.insert(Text::new_or_panic(key), AttributeValue::Text(text));
-        }
-        let encoding =
-            Encoding { compression: Compression::ZIP16, blocks: Blocks::ScanLines, line_order: LineOrder::Increasing };
-        let layer = Layer::new((w, rows), attributes, encoding, AnyChannels::sort(list.into()));
-        let mut out = io::Cursor::new(Vec::new());
-        exr::prelude::Image::from_layer(layer).write().to_buffered(&mut out).map_err(io::Error::other)?;
-        Ok(out.into_inner())
+        encode(&self.header, &self.sums)
     }
 
     /// Writes the partial to `path`, whole or not at all.
     pub fn write(&self, path: &Path) -> io::Result<()> {
-        super::write_atomically(path, &self.encode()?)
+        write(path, &self.header, &self.sums)
     }
 
     /// Reads a partial file; the error says what is wrong with it (not an
@@ -172,6 +132,114 @@ impl Partial {
             p.count = n0[i] as u64 | (n1[i] as u64) << 32;
         }
         Ok(Partial { header, sums })
+    }
+}
+
+/// Writes the sums `sums` with their header as a partial file at `path`,
+/// whole or not at all (without a copy of the sums: a running render's
+/// checkpoint writes its accumulator so).
+pub fn write(path: &Path, header: &PartialHeader, sums: &Accumulator) -> io::Result<()> {
+    super::write_atomically(path, &encode(header, sums)?)
+}
+
+/// Encodes sums and their header as a partial file's EXR bytes: ZIP, lines
+/// in increasing order and the fields in one attribute, so that the same
+/// sums and header give the same bytes whatever the thread count and the
+/// run. The channels are read from the sums line by line as the EXR writer
+/// compresses them ([`SumWords`]), so that the encoding holds no copy of
+/// the sums (104 bytes a pixel).
+pub fn encode(header: &PartialHeader, sums: &Accumulator) -> io::Result<Vec<u8>> {
+    let fields: String = header_fields(header).iter().map(|(key, value)| format!("{key}={value}\n")).collect();
+    encode_with_attributes(header, sums, &[(FIELDS_ATTRIBUTE, fields)])
+}
+
+/// The EXR bytes of the sums with these text attributes in the header.
+fn encode_with_attributes(
+    header: &PartialHeader,
+    sums: &Accumulator,
+    text_attributes: &[(&str, String)],
+) -> io::Result<Vec<u8>> {
+    use exr::prelude::*;
+    let (width, rows) = (header.width as usize, (header.rows.end - header.rows.start) as usize);
+    let pixels = sums.pixels();
+    if pixels.len() != width * rows {
+        return Err(io::Error::other("partial sums do not match their header's size"));
+    }
+    let channel = |name: String, word: Word| AnyChannel::new(name.as_str(), SumWords { pixels, width, word });
+    let mut list = Vec::new();
+    for (c, name) in CHANNELS.iter().enumerate() {
+        for k in 0..4 {
+            list.push(channel(format!("S{name}{k}"), Word::Sum { channel: c, k }));
+            list.push(channel(format!("Q{name}{k}"), Word::Square { channel: c, k }));
+        }
+    }
+    list.extend((0..2).map(|k| channel(format!("N{k}"), Word::Count { k })));
+    let mut attributes = LayerAttributes::named("airlight-partial");
+    for (key, value) in text_attributes {
+        let text = Text::new_or_none(value).ok_or_else(|| io::Error::other("non-ASCII header"))?;
+        attributes.other.insert(Text::new_or_panic(key), AttributeValue::Text(text));
+    }
+    let encoding =
+        Encoding { compression: Compression::ZIP16, blocks: Blocks::ScanLines, line_order: LineOrder::Increasing };
+    let layer = Layer::new((width, rows), attributes, encoding, AnyChannels::sort(list.into()));
+    let mut out = io::Cursor::new(Vec::new());
+    exr::prelude::Image::from_layer(layer).write().to_buffered(&mut out).map_err(io::Error::other)?;
+    Ok(out.into_inner())
+}
+
+/// Which 32-bit word of a pixel's sums a channel of a partial file holds:
+/// word `k` (0 the lowest) of the sum or the sum of squares of colour
+/// channel `channel`, or of the sample count.
+#[derive(Clone, Copy, Debug)]
+enum Word {
+    Sum { channel: usize, k: u32 },
+    Square { channel: usize, k: u32 },
+    Count { k: u32 },
+}
+
+impl Word {
+    fn of(self, p: &PixelSum) -> u32 {
+        let word = |v: u128, k: u32| (v >> (32 * k)) as u32;
+        match self {
+            Word::Sum { channel, k } => word(p.sum[channel] as u128, k),
+            Word::Square { channel, k } => word(p.sum_squares[channel] as u128, k),
+            Word::Count { k } => word(p.count as u128, k),
+        }
+    }
+}
+
+/// One channel of a partial file, `word` of every pixel of `pixels`
+/// (`width` to a row), given to the EXR writer a line at a time as it asks.
+#[derive(Clone, Copy, Debug)]
+struct SumWords<'a> {
+    pixels: &'a [PixelSum],
+    width: usize,
+    word: Word,
+}
+
+impl<'slf, 'a: 'slf> exr::image::write::samples::WritableSamples<'slf> for SumWords<'a> {
+    type Writer = SumWords<'a>;
+
+    fn sample_type(&self) -> exr::meta::attribute::SampleType {
+        exr::meta::attribute::SampleType::U32
+    }
+
+    fn infer_level_modes(&self) -> (exr::meta::attribute::LevelMode, exr::math::RoundingMode) {
+        (exr::meta::attribute::LevelMode::Singular, exr::math::RoundingMode::Down)
+    }
+
+    fn create_samples_writer(&'slf self, _header: &exr::meta::header::Header) -> SumWords<'a> {
+        *self
+    }
+}
+
+impl exr::image::write::samples::SamplesWriter for SumWords<'_> {
+    fn extract_line(&self, line: exr::block::lines::LineRefMut<'_>) {
+        let start = line.location.position.y() * self.width + line.location.position.x();
+        let pixels = &self.pixels[start..start + line.location.sample_count];
+        // The line's buffer is sized by the writer for exactly these
+        // samples; writing them into it cannot fail.
+        line.write_samples(|i| self.word.of(&pixels[i])).expect("a line's buffer holds its samples");
     }
 }
 
@@ -456,10 +524,10 @@ mod tests {
         let attributes: Vec<(&str, String)> = fields.iter().map(|(k, v)| (k.as_str(), v.clone())).collect();
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("p1.exr");
-        std::fs::write(&path, p.encode_with_attributes(&attributes).unwrap()).unwrap();
+        std::fs::write(&path, encode_with_attributes(&p.header, &p.sums, &attributes).unwrap()).unwrap();
         assert_eq!(Partial::read(&path).unwrap(), p);
         let unknown = [(FIELDS_ATTRIBUTE, "format=airlight-partial-9\n".to_string())];
-        std::fs::write(&path, p.encode_with_attributes(&unknown).unwrap()).unwrap();
+        std::fs::write(&path, encode_with_attributes(&p.header, &p.sums, &unknown).unwrap()).unwrap();
         let e = Partial::read(&path).unwrap_err();
         assert!(e.contains("of format `airlight-partial-9`"), "{e}");
     }
