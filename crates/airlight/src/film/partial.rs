@@ -2,7 +2,7 @@
 //! written as an EXR file that `merge` adds up, and `--resume` continues.
 //!
 //! A partial file holds, for each pixel of its band of rows, the
-//! accumulator's fixed-point sums ([`PixelSum`](super::PixelSum)) losslessly as 32-bit
+//! accumulator's fixed-point sums ([`PixelSum`]) losslessly as 32-bit
 //! unsigned channels: `S<c>0`..`S<c>3` for the sum of channel c (R, G, B),
 //! lowest word first, `Q<c>0`..`Q<c>3` for the sum of squares, and `N0`,
 //! `N1` for the sample count. One text attribute of the header,
@@ -146,7 +146,7 @@ pub fn write(path: &Path, header: &PartialHeader, sums: &Accumulator) -> io::Res
 /// in increasing order and the fields in one attribute, so that the same
 /// sums and header give the same bytes whatever the thread count and the
 /// run. The channels are read from the sums line by line as the EXR writer
-/// compresses them ([`SumWords`]), so that the encoding holds no copy of
+/// compresses them, so that the encoding holds no copy of
 /// the sums (104 bytes a pixel).
 pub fn encode(header: &PartialHeader, sums: &Accumulator) -> io::Result<Vec<u8>> {
     let fields: String = header_fields(header).iter().map(|(key, value)| format!("{key}={value}\n")).collect();
