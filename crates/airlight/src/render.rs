@@ -74,12 +74,12 @@ pub fn render(scene: &Scene, integrator: &dyn Integrator, observer: &RenderObser
 ///
 /// Each tile's sums live only while the tile renders, in a buffer of the
 /// tile's size, and leave as the tile's means. They are `PixelTotal`s,
-/// without the sums of squares that only a variance needs: on a large mesh
-/// at 8 samples a pixel the image took 0.91× the time so. The image-sized accumulator
-/// (112 bytes a pixel, against the image's 12) is never made. At 1024² and
-/// one sample per pixel, faulting in its fresh pages and reading it back
-/// made the image take 1.33× the time; at 3840×2160 it was 929 MB of the
-/// 1020 MB the render held.
+/// without the sums of squares that only a variance needs (on a large
+/// mesh at 8 samples a pixel the image took 0.91× the time so). The
+/// image-sized accumulator (112 bytes a pixel, against the image's 12) is
+/// never made: at 1024² and one sample per pixel, faulting in its fresh
+/// pages and reading it back made the image take 1.33× the time; at
+/// 3840×2160 it was 929 MB of the 1020 MB the render held.
 pub fn render_samples(
     scene: &Scene,
     integrator: &dyn Integrator,
