@@ -218,7 +218,7 @@ pub fn render(args: RenderArgs) -> Result<(), String> {
     // As the frames below are rendered: a part first, then passes.
     let film = match (plan.partial, progressive) {
         (true, _) => RenderFilm::Sums,
-        (false, true) => RenderFilm::Progressive,
+        (false, true) => RenderFilm::Progressive { cancellable: false },
         (false, false) => RenderFilm::Image,
     };
     crate::preflight::render_memory(&scene, film)?;

@@ -80,32 +80,36 @@ pub fn try_vec<T: Clone>(what: &str, n: usize, value: T) -> Result<Vec<T>, Memor
 }
 
 /// How a render keeps its pixels, which sets its memory ([`render_bytes`]).
+/// Files are encoded straight to disk, so none is counted.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum RenderFilm {
     /// All samples in one go (`render::render`): each tile's sums live only
-    /// while it renders; the image and its encoded file.
+    /// while it renders; the image and its encoded file (measured at 2048²:
+    /// 19.8 bytes a pixel in all).
     Image,
     /// A part of a render (`render::accumulate`): the accumulator's sums
-    /// and the partial file they are written to, encoded whole, counted as
-    /// if it did not compress (measured at 2048²: 137 bytes a pixel in all
-    /// for the demo scene, 175 for the Cornell box, whose noisy sums
-    /// compress less).
+    /// (measured at 2048²: 121–122 bytes a pixel in all, the demo scene and
+    /// the Cornell box alike).
     Sums,
-    /// Passes (`render::Progressive`): the accumulator, a pass's own sums
-    /// where it can be cancelled, the checkpoint they are written to; the
-    /// image, a variance image and an encoded file (measured at 2048²: 141
-    /// bytes a pixel in all for the demo scene, 176 for the Cornell box).
-    Progressive,
+    /// Passes (`render::Progressive`): the accumulator, the image, a
+    /// variance image and an encoded file; a pass that may be `cancellable`
+    /// (the study's, Python's) adds into sums of its own first, so that a
+    /// cancelled pass adds nothing (measured at 2048² without: 137 bytes a
+    /// pixel in all).
+    Progressive { cancellable: bool },
 }
 
-/// Bytes a render of `pixels` pixels holds at its peak.
+/// Bytes a render of `pixels` pixels holds at its peak: the sums and images
+/// each kind of render keeps ([`RenderFilm`]), with an image's worth to
+/// spare for the rest (tiles under way, encoders' buffers).
 pub fn render_bytes(pixels: u64, film: RenderFilm) -> u64 {
     let sums = crate::film::ACCUMULATOR_BYTES_PER_PIXEL as u64;
     let image = size_of::<crate::Rgb>() as u64;
     let per_pixel = match film {
         RenderFilm::Image => 2 * image,
-        RenderFilm::Sums => 2 * sums + 2 * image,
-        RenderFilm::Progressive => 3 * sums + 3 * image,
+        RenderFilm::Sums => sums + 2 * image,
+        RenderFilm::Progressive { cancellable: false } => sums + 4 * image,
+        RenderFilm::Progressive { cancellable: true } => 2 * sums + 4 * image,
     };
     pixels.saturating_mul(per_pixel)
 }

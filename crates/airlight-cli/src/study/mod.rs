@@ -147,7 +147,9 @@ fn check_memory(scene: &Scene, series: usize) -> Result<(), String> {
     let pixels = s.width as u64 * s.height as u64;
     let image = pixels.saturating_mul(size_of::<airlight::Rgb>() as u64);
     let kept = (series as u64 + 4).saturating_mul(image);
-    let needed = airlight::memory::render_bytes(pixels, airlight::memory::RenderFilm::Progressive).saturating_add(kept);
+    let needed =
+        airlight::memory::render_bytes(pixels, airlight::memory::RenderFilm::Progressive { cancellable: true })
+            .saturating_add(kept);
     airlight::memory::check(format!("a {}×{} study", s.width, s.height), needed)
         .map_err(|e| format!("{e}: make the image smaller (--width, --height)"))
 }

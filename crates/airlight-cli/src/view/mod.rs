@@ -85,7 +85,7 @@ pub fn run(args: ViewArgs) -> Result<(), String> {
     let pixels = args.width as u64 * args.height as u64;
     airlight::memory::check(
         format!("a {}×{} view", args.width, args.height),
-        airlight::memory::render_bytes(pixels, airlight::memory::RenderFilm::Progressive),
+        airlight::memory::render_bytes(pixels, airlight::memory::RenderFilm::Progressive { cancellable: false }),
     )
     .map_err(|e| format!("{e}: make it smaller (--width, --height)"))?;
     crate::preflight::warn_if_dark(scene, true);

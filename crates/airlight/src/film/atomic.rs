@@ -7,11 +7,17 @@
 //! visible, and the folder is synced after it.
 
 use std::fs::{self, File, OpenOptions};
-use std::io::{self, Write};
+use std::io::{self, Seek, SeekFrom, Write};
 use std::os::unix::fs::OpenOptionsExt;
 use std::path::{Path, PathBuf};
 
 pub fn write(path: &Path, bytes: &[u8]) -> io::Result<()> {
+    write_with(path, |file| file.write_all(bytes))
+}
+
+/// As [`write`], with the contents written by `fill` into the new file
+/// (which it may seek in), so that they need not be held in memory whole.
+pub fn write_with(path: &Path, fill: impl FnOnce(&mut File) -> io::Result<()>) -> io::Result<()> {
     let name = path
         .file_name()
         .ok_or_else(|| io::Error::new(io::ErrorKind::InvalidInput, format!("`{}` names no file", path.display())))?;
@@ -22,18 +28,28 @@ pub fn write(path: &Path, bytes: &[u8]) -> io::Result<()> {
     // Linux: a file with no name until it is complete, then linked under a
     // temporary name (rename, unlike link, may replace `path`).
     let mut named = None;
+    let mut fill = Some(fill);
+    // Written but not linked: its contents are copied to a named file.
+    let mut unlinked = None;
     if let Some(mut file) = anonymous(dir) {
-        write_synced(&mut file, bytes)?;
+        write_synced(&mut file, fill.take().expect("not yet used"))?;
         let tmp = temp_name(dir, name);
         if link(&file, &tmp).is_ok() {
             named = Some(tmp);
+        } else {
+            unlinked = Some(file);
         }
     }
     let tmp = match named {
         Some(tmp) => tmp,
         None => {
             let (tmp, mut file) = create_exclusive(dir, name)?;
-            if let Err(e) = write_synced(&mut file, bytes) {
+            let written = match (fill, unlinked) {
+                (Some(fill), _) => write_synced(&mut file, fill),
+                (None, Some(mut unlinked)) => write_synced(&mut file, |file| copy_whole(&mut unlinked, file)),
+                (None, None) => unreachable!("the contents are written to the anonymous file or still to write"),
+            };
+            if let Err(e) = written {
                 let _ = fs::remove_file(&tmp);
                 return Err(e);
             }
@@ -48,8 +64,14 @@ pub fn write(path: &Path, bytes: &[u8]) -> io::Result<()> {
     result
 }
 
-fn write_synced(file: &mut File, bytes: &[u8]) -> io::Result<()> {
-    file.write_all(bytes)?;
+/// Copies all of `from`, from its start, to `to`.
+fn copy_whole(from: &mut File, to: &mut File) -> io::Result<()> {
+    from.seek(SeekFrom::Start(0))?;
+    io::copy(from, to).map(drop)
+}
+
+fn write_synced(file: &mut File, fill: impl FnOnce(&mut File) -> io::Result<()>) -> io::Result<()> {
+    fill(file)?;
     file.sync_all()
 }
 
@@ -180,10 +202,51 @@ mod tests {
             eprintln!("this file system has no O_TMPFILE: the named fallback is used");
             return;
         };
-        write_synced(&mut file, b"whole").unwrap();
+        write_synced(&mut file, |f| f.write_all(b"whole")).unwrap();
         assert!(names(dir.path()).is_empty(), "nothing to see, or to leave behind, while writing");
         link(&file, &dir.path().join("done")).unwrap();
         assert_eq!(fs::read(dir.path().join("done")).unwrap(), b"whole");
+    }
+
+    #[test]
+    fn contents_may_be_written_with_seeks() {
+        let dir = tempfile::tempdir().unwrap();
+        let out = dir.path().join("out.bin");
+        // As an EXR writer does: a placeholder, the data, then the
+        // placeholder filled in.
+        write_with(&out, |f| {
+            f.write_all(b"????-data")?;
+            f.seek(SeekFrom::Start(0))?;
+            f.write_all(b"head")
+        })
+        .unwrap();
+        assert_eq!(fs::read(&out).unwrap(), b"head-data");
+        assert_eq!(names(dir.path()), ["out.bin"]);
+    }
+
+    #[test]
+    fn a_file_written_without_a_name_is_copied_whole() {
+        let dir = tempfile::tempdir().unwrap();
+        let mut from = tempfile::tempfile().unwrap();
+        from.write_all(b"all of it").unwrap();
+        let (tmp, mut to) = create_exclusive(dir.path(), "out.bin".as_ref()).unwrap();
+        copy_whole(&mut from, &mut to).unwrap();
+        assert_eq!(fs::read(&tmp).unwrap(), b"all of it");
+    }
+
+    #[test]
+    fn a_failed_fill_leaves_nothing_and_keeps_the_old_file() {
+        let dir = tempfile::tempdir().unwrap();
+        let out = dir.path().join("out.bin");
+        fs::write(&out, b"old").unwrap();
+        let e = write_with(&out, |f| {
+            f.write_all(b"half")?;
+            Err(io::Error::other("disk full"))
+        })
+        .unwrap_err();
+        assert_eq!(e.to_string(), "disk full");
+        assert_eq!(fs::read(&out).unwrap(), b"old");
+        assert_eq!(names(dir.path()), ["out.bin"]);
     }
 
     #[test]

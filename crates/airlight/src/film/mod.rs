@@ -238,6 +238,12 @@ pub fn write_atomically(path: &Path, bytes: &[u8]) -> io::Result<()> {
     atomic::write(path, bytes)
 }
 
+/// As [`write_atomically`], with the contents written by `fill` into the
+/// new file (which it may seek in) rather than held in memory whole.
+pub fn write_atomically_with(path: &Path, fill: impl FnOnce(&mut std::fs::File) -> io::Result<()>) -> io::Result<()> {
+    atomic::write_with(path, fill)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -21,7 +21,7 @@
 
 use super::{Accumulator, PixelSum};
 use std::collections::BTreeMap;
-use std::io;
+use std::io::{self, Write};
 use std::ops::Range;
 use std::path::Path;
 
@@ -136,10 +136,15 @@ impl Partial {
 }
 
 /// Writes the sums `sums` with their header as a partial file at `path`,
-/// whole or not at all (without a copy of the sums: a running render's
-/// checkpoint writes its accumulator so).
+/// whole or not at all, the bytes of [`encode`]. The file is encoded
+/// straight to disk, holding neither a copy of the sums nor the encoded
+/// file in memory (a running render's checkpoint writes its accumulator so).
 pub fn write(path: &Path, header: &PartialHeader, sums: &Accumulator) -> io::Result<()> {
-    super::write_atomically(path, &encode(header, sums)?)
+    super::write_atomically_with(path, |file| {
+        let mut out = io::BufWriter::new(file);
+        encode_into(header, sums, &[(FIELDS_ATTRIBUTE, header_text(header))], &mut out)?;
+        out.flush()
+    })
 }
 
 /// Encodes sums and their header as a partial file's EXR bytes: ZIP, lines
@@ -149,8 +154,13 @@ pub fn write(path: &Path, header: &PartialHeader, sums: &Accumulator) -> io::Res
 /// compresses them, so that the encoding holds no copy of
 /// the sums (104 bytes a pixel).
 pub fn encode(header: &PartialHeader, sums: &Accumulator) -> io::Result<Vec<u8>> {
-    let fields: String = header_fields(header).iter().map(|(key, value)| format!("{key}={value}\n")).collect();
-    encode_with_attributes(header, sums, &[(FIELDS_ATTRIBUTE, fields)])
+    encode_with_attributes(header, sums, &[(FIELDS_ATTRIBUTE, header_text(header))])
+}
+
+/// The header's fields as the text of the [`FIELDS_ATTRIBUTE`]: a
+/// `key=value` line each.
+fn header_text(header: &PartialHeader) -> String {
+    header_fields(header).iter().map(|(key, value)| format!("{key}={value}\n")).collect()
 }
 
 /// The EXR bytes of the sums with these text attributes in the header.
@@ -159,6 +169,18 @@ fn encode_with_attributes(
     sums: &Accumulator,
     text_attributes: &[(&str, String)],
 ) -> io::Result<Vec<u8>> {
+    let mut out = io::Cursor::new(Vec::new());
+    encode_into(header, sums, text_attributes, &mut out)?;
+    Ok(out.into_inner())
+}
+
+/// Encodes the sums with these text attributes in the header into `out`.
+fn encode_into(
+    header: &PartialHeader,
+    sums: &Accumulator,
+    text_attributes: &[(&str, String)],
+    out: &mut (impl io::Write + io::Seek),
+) -> io::Result<()> {
     use exr::prelude::*;
     let (width, rows) = (header.width as usize, (header.rows.end - header.rows.start) as usize);
     let pixels = sums.pixels();
@@ -182,9 +204,7 @@ fn encode_with_attributes(
     let encoding =
         Encoding { compression: Compression::ZIP16, blocks: Blocks::ScanLines, line_order: LineOrder::Increasing };
     let layer = Layer::new((width, rows), attributes, encoding, AnyChannels::sort(list.into()));
-    let mut out = io::Cursor::new(Vec::new());
-    exr::prelude::Image::from_layer(layer).write().to_buffered(&mut out).map_err(io::Error::other)?;
-    Ok(out.into_inner())
+    exr::prelude::Image::from_layer(layer).write().to_buffered(out).map_err(io::Error::other)
 }
 
 /// Which 32-bit word of a pixel's sums a channel of a partial file holds:
@@ -495,6 +515,8 @@ mod tests {
         let p = part(1..3, 2..5, 7);
         p.write(&path).unwrap();
         assert_eq!(Partial::read(&path).unwrap(), p);
+        // Encoded straight to the file, the bytes of the encoding in memory.
+        assert_eq!(std::fs::read(&path).unwrap(), p.encode().unwrap());
     }
 
     /// The writer orders a header's attributes as a hash map with keys
