@@ -190,7 +190,7 @@ impl Geometry {
                     self.packet_leaf_closest::<L>(first, count, mixed, rays, p);
                     0
                 };
-                bvh.packet::<L>(p, p.all(), leaf, |first, count| self.prefetch_triangles(first, count));
+                bvh.packet::<L, true>(p, p.all(), leaf, |first, count| self.prefetch_triangles(first, count));
                 for (k, &i) in indices.iter().enumerate() {
                     let mut best = Hit { t: p.tmax[k], id: p.id[k] };
                     self.intersect_unbounded(&rays[i], &mut best);
@@ -241,7 +241,7 @@ impl Geometry {
                     found |= b;
                     b
                 };
-                bvh.packet::<L>(p, open, leaf, |first, count| self.prefetch_triangles(first, count));
+                bvh.packet::<L, false>(p, open, leaf, |first, count| self.prefetch_triangles(first, count));
                 for (k, &i) in indices.iter().enumerate() {
                     blocked[i] |= found & (1 << k) != 0;
                 }
