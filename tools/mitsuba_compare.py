@@ -326,7 +326,11 @@ def main():
             # Each image's own error is the seed-to-seed difference over √2;
             # error falls as 1/√time, so equal error costs time · error².
             e_m = field(mitsuba_noise, "rel_rmse") / math.sqrt(2)
-            print(f"  Mitsuba {variant} ({args.mitsuba_sampler} sampler): {mitsuba_seconds:.3f} s, own error {e_m:.4f}; per sample Airlight is {mitsuba_seconds / airlight_seconds:.2f}x as fast", end="")
+            # Some samplers round the count up (multijitter: 512 → 528), so
+            # the per-sample ratio takes the count each renderer drew.
+            mitsuba_spp = scene.sensors()[0].sampler().sample_count()
+            per_sample = (mitsuba_seconds / mitsuba_spp) / (airlight_seconds / args.spp)
+            print(f"  Mitsuba {variant} ({args.mitsuba_sampler} sampler, {mitsuba_spp} spp): {mitsuba_seconds:.3f} s, own error {e_m:.4f}; per sample Airlight is {per_sample:.2f}x as fast", end="")
             if e_a > 0:
                 speedup = (mitsuba_seconds * e_m**2) / (airlight_seconds * e_a**2)
                 print(f", at equal error {speedup:.2f}x", end="")
