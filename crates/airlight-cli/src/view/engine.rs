@@ -236,7 +236,6 @@ impl Engine {
         if count > 0 {
             let t = Instant::now();
             let size = self.size();
-            let mut sums = take_sums(&mut self.accumulator, size);
             match self.mode {
                 Mode::Preview => {
                     let preview = Preview::new(
@@ -258,7 +257,10 @@ impl Engine {
                         stats.samples = 1;
                         return stats;
                     }
+                    // Taken only now: a first-sample frame keeps no sums.
+                    let mut sums = take_sums(&mut self.accumulator, size);
                     self.add_samples(&preview, count, &mut sums);
+                    self.accumulator = Samples::Sums(sums);
                 }
                 Mode::Raymarch | Mode::Stochastic => {
                     let kind =
@@ -266,12 +268,13 @@ impl Engine {
                     // Progressive refinement wants jittered march samples.
                     let mut desc = self.integrators.with_kind(kind);
                     desc.raymarch.jitter = true;
+                    let mut sums = take_sums(&mut self.accumulator, size);
                     if let Ok(integrator) = desc.build(&self.scene) {
                         self.add_samples(integrator.as_ref(), count, &mut sums);
                     }
+                    self.accumulator = Samples::Sums(sums);
                 }
             }
-            self.accumulator = Samples::Sums(sums);
             self.samples += count;
             stats.image = t.elapsed();
         }
