@@ -4,7 +4,10 @@ rays of `examples/bench_bvh.rs`, beside Airlight's figures for the same
 rays: the displaced sphere of 1,125,000 triangles (tools/mesh_scene.py),
 one primary ray through the centre of each pixel of a 1024×1024 image (the
 camera of the mesh scene, rays in 8×8 blocks, each block in Z order), then
-one shadow ray from each hit toward the point light at (2, 3, −3).
+one shadow ray from each hit toward the point light at (2, 3, −3), then
+from each hit a diffuse bounce into the mesh (across its inside, as rays
+between the walls of a room) and one out of it: incoherent rays, the
+numbers of bounce i from SplitMix64 of i + 1, as bench_bvh draws them.
 
     python3 tools/mesh_scene.py
     cargo build --release -p airlight --example bench_bvh
@@ -14,7 +17,7 @@ one shadow ray from each hit toward the point light at (2, 3, −3).
 Mitsuba traces the rays as one wavefront on all cores:
 `scene.ray_intersect_preliminary` (distance and triangle only, as
 Airlight's `intersect_packet`) and `scene.ray_test` (any hit, as
-`occluded_packet`), both marked coherent. Each is timed after a warm-up
+`occluded_packet`), both marked coherent; the bounces unmarked. Each is timed after a warm-up
 call that compiles its kernel, waiting for the result (`dr.eval`,
 `dr.sync_thread`), as the median of --passes passes. Airlight's figures are
 bench_bvh's medians on all threads (packets on the widest lanes the
@@ -82,15 +85,29 @@ def timed(passes, run):
 
 
 def airlight_figures(bench):
-    """bench_bvh's all-thread rays per second (M) for its packets:
-    {'primary': x, 'shadow': y}, from its first report (the widest lanes)."""
+    """bench_bvh's all-thread rays per second (M): {'primary': x, 'shadow':
+    y} for its packets, from its first report (the widest lanes), and
+    'into', 'out of' for its bounces one ray at a time and in packets
+    ('into packets', 'out of packets')."""
     out = subprocess.run([bench, "--no-reference"], capture_output=True, text=True, check=True).stdout
     figures = {}
+    bounce = None
     for line in out.splitlines():
         words = line.split()
+        if line.startswith("bounce rays into"):
+            bounce = "into"
+        elif line.startswith("bounce rays out"):
+            bounce = "out of"
+        elif not line.startswith(" "):
+            bounce = None
+        rate = lambda: float(line.split("threads:")[1].split()[0])
         if words and words[0] in ("primary", "shadow") and words[0] not in figures:
             # "primary 1 thread: A M rays/s (B per CPU s, passes C-D)   T threads: E M rays/s (F per CPU s)"
-            figures[words[0]] = float(line.split("threads:")[1].split()[0])
+            figures[words[0]] = rate()
+        elif bounce and line.strip().startswith("one ray at a time"):
+            figures[bounce] = rate()
+        elif bounce and line.strip().startswith("packets"):
+            figures[bounce + " packets"] = rate()
     return figures
 
 
@@ -150,11 +167,47 @@ def main():
 
     t_shadow, fastest_s, slowest_s, blocked = timed(args.passes, occluded)
     m = len(start)
+
+    # The bounces: each hit's normal turned along its camera ray (into the
+    # mesh) or against it, plus a uniform unit vector: a cosine-weighted
+    # direction; the origin off the surface as Airlight's offset_origin.
+    along = np.where(np.sum(normal * dirs[valid], axis=1) < 0.0, -1.0, 1.0).astype(np.float32)[:, None] * normal
+    z = (np.arange(m, dtype=np.uint64) + np.uint64(1)) * np.uint64(0x9E3779B97F4A7C15)
+    z = (z ^ (z >> np.uint64(30))) * np.uint64(0xBF58476D1CE4E5B9)
+    z = (z ^ (z >> np.uint64(27))) * np.uint64(0x94D049BB133111EB)
+    z ^= z >> np.uint64(31)
+    u = (z >> np.uint64(40)).astype(np.float32) / np.float32(1 << 24)
+    v = ((z >> np.uint64(8)) & np.uint64(0xFFFFFF)).astype(np.float32) / np.float32(1 << 24)
+    cz = 1.0 - 2.0 * u
+    r = np.sqrt(np.maximum(0.0, 1.0 - cz * cz))
+    phi = np.float32(2.0 * np.pi) * v
+    sphere = np.stack([r * np.cos(phi), r * np.sin(phi), cz], axis=1).astype(np.float32)
+    bounces = {}
+    for kind, n_side in (("into", along), ("out of", -along)):
+        d = n_side + sphere
+        d /= np.linalg.norm(d, axis=1, keepdims=True)
+        o = p_hit + n_side * scale[:, None]
+        bounce_rays = mi.Ray3f(
+            mi.Point3f(*[mi.Float(np.ascontiguousarray(o[:, a])) for a in range(3)]),
+            mi.Vector3f(*[mi.Float(np.ascontiguousarray(d[:, a])) for a in range(3)]),
+        )
+
+        def trace(bounce_rays=bounce_rays):
+            pi = scene.ray_intersect_preliminary(bounce_rays, coherent=False)
+            dr.eval(pi.t)
+            dr.sync_thread()
+            return pi
+
+        t_bounce, fastest_b, slowest_b, pi = timed(args.passes, trace)
+        hit = float(np.isfinite(np.array(pi.t)).mean())
+        bounces[kind] = (m / t_bounce / 1e6, m / slowest_b / 1e6, m / fastest_b / 1e6, hit)
     print(f"mesh: {args.mesh}; {n} primary rays, {100.0 * m / n:.1f}% hit; {m} shadow rays, "
           f"{100.0 * int(np.array(blocked, bool).sum()) / m:.1f}% blocked")
     print(f"Mitsuba {args.variant}, {dr.thread_count()} threads, medians of {args.passes} passes:")
     print(f"  primary {n / t_primary / 1e6:6.2f} M rays/s (passes {n / slowest_p / 1e6:.2f}-{n / fastest_p / 1e6:.2f})")
     print(f"  shadow  {m / t_shadow / 1e6:6.2f} M rays/s (passes {m / slowest_s / 1e6:.2f}-{m / fastest_s / 1e6:.2f})")
+    for kind, (rate, slowest, fastest, hit) in bounces.items():
+        print(f"  bounces {kind} the mesh ({100 * hit:.1f}% hit) {rate:6.2f} M rays/s (passes {slowest:.2f}-{fastest:.2f})")
     if args.no_airlight:
         return
     if not os.path.exists(args.bench):
@@ -163,6 +216,10 @@ def main():
     print("Airlight packets (bench_bvh, all threads, medians of its passes):")
     for kind, mitsuba in (("primary", n / t_primary / 1e6), ("shadow", m / t_shadow / 1e6)):
         print(f"  {kind:7} {figures[kind]:6.2f} M rays/s: {figures[kind] / mitsuba:.2f}x Mitsuba's")
+    print("Airlight bounces (bench_bvh, all threads, one ray at a time and in packets):")
+    for kind, (rate, _, _, _) in bounces.items():
+        one, packets = figures[kind], figures[kind + " packets"]
+        print(f"  {kind:6} the mesh {one:6.2f} and {packets:6.2f} M rays/s: {one / rate:.2f}x and {packets / rate:.2f}x Mitsuba's")
 
 
 if __name__ == "__main__":

@@ -10,9 +10,13 @@
 //! (`intersect_packet`, `occluded_packet`, 256 rays a call) with each lane
 //! width the processor has, widest first (sixteen rays at a time with
 //! AVX-512, eight with AVX, four with SSE), and one ray at a time
-//! (`intersect`, `occluded`). Then the same rays through obvhs's
-//! compressed 8-wide BVH and its traversal (what Airlight used before the
-//! 4-wide tree), unless `--no-reference` is given. In between, the whole
+//! (`intersect`, `occluded`). Then incoherent rays: from each hit a
+//! diffuse bounce into the mesh (across its inside, as rays between the
+//! walls of a room) and one out of it, one ray at a time and in packets
+//! (`tools/mitsuba_rays.py` traces the same through Mitsuba). Last, the
+//! camera and shadow rays through obvhs's compressed 8-wide BVH and its
+//! traversal (what Airlight used before the 4-wide tree), unless
+//! `--no-reference` is given. In between, the whole
 //! render of that image with the direct integrator (camera ray, shadow ray
 //! and shading; the scene of `tools/mesh_scene.py`) on all threads, with
 //! samples handed over in blocks (packets) and one by one.
@@ -87,6 +91,23 @@ fn main() {
         .iter()
         .map(|ray| geometry.intersect(ray, f32::INFINITY).map(|hit| (ray.at(hit.t), geometry.surface(ray, hit).n)))
         .collect();
+    // Incoherent rays: from each hit, a diffuse bounce (cosine-weighted
+    // about the normal) into the mesh, across its inside as between the
+    // walls of a room, and one out of it, back toward the camera.
+    let bounce = |inward: bool| -> Vec<Ray> {
+        rays.iter()
+            .zip(&hit_points)
+            .filter_map(|(ray, hit)| hit.map(|(p, n)| (ray, p, n)))
+            .enumerate()
+            .map(|(i, (ray, p, n))| {
+                let along = if n.dot(ray.dir) < 0.0 { -n } else { n };
+                let normal = if inward { along } else { -along };
+                let dir = (normal + uniform_sphere(bounce_numbers(i as u64))).normalize();
+                Ray::new(offset_origin(p, normal, dir), dir)
+            })
+            .collect()
+    };
+    let (bounce_in, bounce_out) = (bounce(true), bounce(false));
     let hits = hit_points.iter().filter(|h| h.is_some()).count();
     println!("{} primary rays, {:.1}% hit the mesh", rays.len(), 100.0 * hits as f64 / rays.len() as f64);
     // One shadow ray from each hit toward a point light, as direct lighting
@@ -152,6 +173,27 @@ fn main() {
         p.one_cpu / pp.one_cpu,
         s.one_cpu / sp.one_cpu
     );
+
+    for (name, bounce) in [("bounce rays into the mesh", &bounce_in), ("bounce rays out of it", &bounce_out)] {
+        let one = time(bounce, |rays: &[Ray]| {
+            rays.iter().map(|ray| geometry.intersect(ray, f32::INFINITY).is_some() as u64).sum()
+        });
+        let packets = time(bounce, primary_with(LaneWidth::widest()));
+        assert_eq!(one.sum, packets.sum, "{name}: packets and single rays disagree on hits");
+        println!(
+            "{name} ({} rays, {:.1}% hit; medians of {PASSES} passes):",
+            bounce.len(),
+            100.0 * one.sum as f64 / bounce.len() as f64
+        );
+        let m = bounce.len() as f64 / 1e6;
+        for (kind, t) in [("one ray at a time", &one), ("packets", &packets)] {
+            println!(
+                "  {kind:17} 1 thread: {:6.2} M rays/s   {threads} threads: {:6.2} M rays/s",
+                m / t.one,
+                m / t.all
+            );
+        }
+    }
 
     render_direct(mesh.clone(), camera, light, w, h);
 
@@ -220,6 +262,26 @@ fn main() {
         pr.one_cpu / pp.one_cpu,
         sr.one_cpu / sp.one_cpu
     );
+}
+
+/// Two numbers in [0, 1) for bounce `i`: SplitMix64 of i + 1 (Steele, Lea
+/// and Flood 2014), its top and next 24 bits, so that
+/// `tools/mitsuba_rays.py` draws the same bounces.
+fn bounce_numbers(i: u64) -> glam::Vec2 {
+    let mut z = (i + 1).wrapping_mul(0x9e37_79b9_7f4a_7c15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+    z ^= z >> 31;
+    let unit = |bits: u64| bits as f32 / (1u32 << 24) as f32;
+    glam::Vec2::new(unit(z >> 40), unit((z >> 8) & 0xff_ffff))
+}
+
+/// A uniform direction: z = 1 − 2u, the azimuth 2πv.
+fn uniform_sphere(u: glam::Vec2) -> Vec3 {
+    let z = 1.0 - 2.0 * u.x;
+    let r = (1.0 - z * z).max(0.0).sqrt();
+    let phi = 2.0 * std::f32::consts::PI * u.y;
+    vec3(r * phi.cos(), r * phi.sin(), z)
 }
 
 /// The CPU time this thread or process has used: rates per CPU second hold

@@ -316,17 +316,22 @@ impl Geometry {
                 Some(bvh) => {
                     let (o, d) = (ray.origin, ray.dir);
                     let box_ray = BoxRay::new(o.to_array(), d.to_array());
-                    let found = bvh.closest(&box_ray, tmax, |first, count, mixed, (mut best_t, mut best_id)| {
-                        let mut found = None;
-                        for i in first..first + count {
-                            let t = self.intersect_one(i as usize, mixed, o, d, test_bound(best_t, best_id));
-                            if comes_before(t, i, best_t, best_id) {
-                                (best_t, best_id) = (t, i);
-                                found = Some((t, i));
+                    let found = bvh.closest(
+                        &box_ray,
+                        tmax,
+                        |first, count, mixed, (mut best_t, mut best_id)| {
+                            let mut found = None;
+                            for i in first..first + count {
+                                let t = self.intersect_one(i as usize, mixed, o, d, test_bound(best_t, best_id));
+                                if comes_before(t, i, best_t, best_id) {
+                                    (best_t, best_id) = (t, i);
+                                    found = Some((t, i));
+                                }
                             }
-                        }
-                        found
-                    });
+                            found
+                        },
+                        |first, count| self.prefetch_triangles(first, count),
+                    );
                     if let Some((t, id)) = found {
                         best = Hit { t, id };
                     }

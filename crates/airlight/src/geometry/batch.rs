@@ -251,7 +251,7 @@ impl Geometry {
 
     /// Starts fetching the compact copies of triangles `first .. first + count`.
     #[inline(always)]
-    fn prefetch_triangles(&self, first: u32, count: u32) {
+    pub(super) fn prefetch_triangles(&self, first: u32, count: u32) {
         if let Some(t) = self.triangles.get(first as usize..(first + count) as usize) {
             super::packet::prefetch(&t[0]);
             if let Some(last) = t.last() {
