@@ -6,6 +6,8 @@
 use super::Ray;
 use super::batch::{comes_before, test_bound};
 use super::bvh4::{self, BoxRay, Bvh4};
+use super::lanes::{Lanes, NativeLanes};
+use super::packet::{triangle_hits, triangle_terms};
 use super::quad_lanes::QuadLanes;
 use super::records::{
     Instance, NO_UV, PlaneRecord, Prim, Record, SdfPrim, UNBOUNDED_FAR, UnboundedSdf, barycentric, intersect_plane,
@@ -320,6 +322,9 @@ impl Geometry {
                         &box_ray,
                         tmax,
                         |first, count, mixed, (mut best_t, mut best_id)| {
+                            if !mixed {
+                                return self.leaf_nearest(first, count, o, d, (best_t, best_id));
+                            }
                             let mut found = None;
                             for i in first..first + count {
                                 let t = self.intersect_one(i as usize, mixed, o, d, test_bound(best_t, best_id));
@@ -427,6 +432,54 @@ impl Geometry {
             }
         }
         false
+    }
+
+    /// Of triangles `first .. first + count` (a leaf of triangles only), the
+    /// nearest hit that comes before `best` (as [`comes_before`] orders
+    /// them), if any: four triangles at a time in SIMD lanes, each lane
+    /// operation for operation as [`intersect_triangle`], and the lanes'
+    /// hits then taken in index order against the bound the one-triangle
+    /// loop would use, so that the answer is that loop's, bit for bit. A
+    /// ray across the inside of a 1.1 M-triangle mesh tests about 19
+    /// triangles in 4 leaves.
+    #[inline(always)]
+    fn leaf_nearest(&self, first: u32, count: u32, o: Vec3, d: Vec3, best: (f32, u32)) -> Option<(f32, u32)> {
+        type L = NativeLanes;
+        let (mut best_t, mut best_id) = best;
+        let mut found = None;
+        let splat = |v: Vec3| [L::splat(v.x), L::splat(v.y), L::splat(v.z)];
+        let (d4, o4) = (splat(d), splat(o));
+        let end = first + count;
+        let mut start = first;
+        while start < end {
+            let n = (end - start).min(4) as usize;
+            let group = &self.triangles[start as usize..start as usize + n];
+            // Lanes past the leaf's last triangle hold a degenerate one
+            // (zero edges: no determinant), which never hits.
+            let lanes = |vertex: usize| {
+                [0, 1, 2].map(|axis| {
+                    let mut a = [0.0f32; 4];
+                    for (k, t) in group.iter().enumerate() {
+                        a[k] = t[vertex][axis];
+                    }
+                    L::load(&a)
+                })
+            };
+            let (hits, t) = triangle_hits(triangle_terms(d4, o4, lanes(0), lanes(1), lanes(2)));
+            let t = t.to_array();
+            let mut m = hits & ((1u32 << n) - 1);
+            while m != 0 {
+                let k = m.trailing_zeros() as usize;
+                m &= m - 1;
+                let (t, i) = (t[k], start + k as u32);
+                if t < test_bound(best_t, best_id) && comes_before(t, i, best_t, best_id) {
+                    (best_t, best_id) = (t, i);
+                    found = Some((t, i));
+                }
+            }
+            start += n as u32;
+        }
+        found
     }
 
     /// Record `i`'s hit distance in (0, tmax), or infinity: from the compact

@@ -205,26 +205,17 @@ impl Packet {
         (tnear.le(tfar), [t[0], t[1], t[2], t[3]])
     }
 
-    /// Möller–Trumbore's terms for rays `s..s + L::WIDTH`, operation for
-    /// operation as [`super::intersect_triangle`]: the determinant and the
-    /// numerators of u, v and t (each still to be divided by it).
+    /// Möller–Trumbore's terms for rays `s..s + L::WIDTH` against one
+    /// triangle ([`triangle_terms`]).
     #[inline(always)]
     fn triangle_terms<L: Lanes>(&self, s: usize, triangle: &[Vec3; 3]) -> [L; 4] {
         let d = [L::load(&self.dir[0][s..]), L::load(&self.dir[1][s..]), L::load(&self.dir[2][s..])];
         let o = [L::load(&self.origin[0][s..]), L::load(&self.origin[1][s..]), L::load(&self.origin[2][s..])];
         // Each component read on its own: copying the 12-byte vectors whole
         // and reloading them as 16 bytes stalled store forwarding.
-        let v0 = &triangle[0];
-        let [e1, e2] = [&triangle[1], &triangle[2]].map(|e| [L::splat(e.x), L::splat(e.y), L::splat(e.z)]);
-        let cross = |a: &[L; 3], b: &[L; 3]| {
-            [a[1].mul(b[2]).sub(b[1].mul(a[2])), a[2].mul(b[0]).sub(b[2].mul(a[0])), a[0].mul(b[1]).sub(b[0].mul(a[1]))]
-        };
-        let dot = |a: &[L; 3], b: &[L; 3]| a[0].mul(b[0]).add(a[1].mul(b[1])).add(a[2].mul(b[2]));
-        let pvec = cross(&d, &e2);
-        let det = dot(&e1, &pvec);
-        let tvec = [o[0].sub(L::splat(v0.x)), o[1].sub(L::splat(v0.y)), o[2].sub(L::splat(v0.z))];
-        let qvec = cross(&tvec, &e1);
-        [det, dot(&tvec, &pvec), dot(&d, &qvec), dot(&e2, &qvec)]
+        let [v0, e1, e2] =
+            [&triangle[0], &triangle[1], &triangle[2]].map(|e| [L::splat(e.x), L::splat(e.y), L::splat(e.z)]);
+        triangle_terms(d, o, v0, e1, e2)
     }
 
     /// Möller–Trumbore against rays `s..s + L::WIDTH`, operation for operation as
@@ -232,16 +223,7 @@ impl Packet {
     /// (no upper bound applied) and the lanes' t.
     #[inline(always)]
     pub fn triangle_lanes<L: Lanes>(&self, s: usize, triangle: &[Vec3; 3]) -> (u32, L) {
-        let [det, u, v, t] = self.triangle_terms::<L>(s, triangle);
-        let ok_det = !det.abs().lt(L::splat(1e-20)) & lane_mask::<L>() as u32;
-        let inv_det = L::splat(1.0).div(det);
-        let u = u.mul(inv_det);
-        let ok_u = L::splat(0.0).le(u) & u.le(L::splat(1.0));
-        let v = v.mul(inv_det);
-        let miss_v = v.lt(L::splat(0.0)) | L::splat(1.0).lt(u.add(v));
-        let t = t.mul(inv_det);
-        let ok_t = L::splat(0.0).lt(t);
-        (ok_det & ok_u & !miss_v & ok_t, t)
+        triangle_hits(self.triangle_terms::<L>(s, triangle))
     }
 
     /// Of rays `s..s + L::WIDTH`, those the triangle blocks before their
@@ -258,6 +240,39 @@ impl Packet {
         let ok_t = L::splat(0.0).lt(t) & t.lt(L::load(&self.tmax[s..]).mul(abs_det));
         ok_det & ok_u & !miss_v & ok_t
     }
+}
+
+/// Möller–Trumbore's terms, operation for operation as
+/// [`super::intersect_triangle`], lane by lane (rays in the lanes and one
+/// triangle splat, or one ray splat and triangles in the lanes): the
+/// determinant and the numerators of u, v and t (each still to be divided
+/// by it).
+#[inline(always)]
+pub(super) fn triangle_terms<L: Lanes>(d: [L; 3], o: [L; 3], v0: [L; 3], e1: [L; 3], e2: [L; 3]) -> [L; 4] {
+    let cross = |a: &[L; 3], b: &[L; 3]| {
+        [a[1].mul(b[2]).sub(b[1].mul(a[2])), a[2].mul(b[0]).sub(b[2].mul(a[0])), a[0].mul(b[1]).sub(b[0].mul(a[1]))]
+    };
+    let dot = |a: &[L; 3], b: &[L; 3]| a[0].mul(b[0]).add(a[1].mul(b[1])).add(a[2].mul(b[2]));
+    let pvec = cross(&d, &e2);
+    let det = dot(&e1, &pvec);
+    let tvec = [o[0].sub(v0[0]), o[1].sub(v0[1]), o[2].sub(v0[2])];
+    let qvec = cross(&tvec, &e1);
+    [det, dot(&tvec, &pvec), dot(&d, &qvec), dot(&e2, &qvec)]
+}
+
+/// From [`triangle_terms`], as [`super::intersect_triangle`] decides: the
+/// mask of lanes with a hit at t > 0 (no upper bound applied) and their t.
+#[inline(always)]
+pub(super) fn triangle_hits<L: Lanes>([det, u, v, t]: [L; 4]) -> (u32, L) {
+    let ok_det = !det.abs().lt(L::splat(1e-20)) & lane_mask::<L>() as u32;
+    let inv_det = L::splat(1.0).div(det);
+    let u = u.mul(inv_det);
+    let ok_u = L::splat(0.0).le(u) & u.le(L::splat(1.0));
+    let v = v.mul(inv_det);
+    let miss_v = v.lt(L::splat(0.0)) | L::splat(1.0).lt(u.add(v));
+    let t = t.mul(inv_det);
+    let ok_t = L::splat(0.0).lt(t);
+    (ok_det & ok_u & !miss_v & ok_t, t)
 }
 
 /// The mask of one group of `L::WIDTH` lanes.
