@@ -92,10 +92,9 @@ pub enum RenderFilm {
     /// the Cornell box alike).
     Sums,
     /// Passes (`render::Progressive`): the accumulator, the image, a
-    /// variance image and an encoded file; a pass that may be `cancellable`
-    /// (the study's, Python's) adds into sums of its own first, so that a
-    /// cancelled pass adds nothing (measured at 2048² without: 137 bytes a
-    /// pixel in all).
+    /// variance image and an encoded file (measured at 2048²: 137 bytes a
+    /// pixel in all). A pass that may be `cancellable` (the study's) adds
+    /// into sums of its own first, so that a cancelled pass adds nothing.
     Progressive { cancellable: bool },
 }
 
