@@ -15,7 +15,7 @@ pub fn write(path: &Path, bytes: &[u8]) -> io::Result<()> {
     write_with(path, |file| file.write_all(bytes))
 }
 
-/// As [`write`], with the contents written by `fill` into the new file
+/// As [`write`](fn@write), with the contents written by `fill` into the new file
 /// (which it may seek in), so that they need not be held in memory whole.
 pub fn write_with(path: &Path, fill: impl FnOnce(&mut File) -> io::Result<()>) -> io::Result<()> {
     let name = path

@@ -13,7 +13,7 @@ use super::records::{
     Instance, NO_UV, PlaneRecord, Prim, Record, SdfPrim, UNBOUNDED_FAR, UnboundedSdf, barycentric, intersect_plane,
 };
 use super::sdf::sphere_trace;
-use super::shape::{Shape, intersect_triangle, triangle_blocks};
+use super::shape::{Shape, triangle_blocks};
 use glam::{Mat3, Vec2, Vec3, Vec3A};
 use obvhs::{BvhBuildParams, aabb::Aabb};
 use std::time::Duration;
@@ -327,7 +327,7 @@ impl Geometry {
                             }
                             let mut found = None;
                             for i in first..first + count {
-                                let t = self.intersect_one(i as usize, mixed, o, d, test_bound(best_t, best_id));
+                                let t = self.intersect_one(i as usize, o, d, test_bound(best_t, best_id));
                                 if comes_before(t, i, best_t, best_id) {
                                     (best_t, best_id) = (t, i);
                                     found = Some((t, i));
@@ -437,7 +437,7 @@ impl Geometry {
     /// Of triangles `first .. first + count` (a leaf of triangles only), the
     /// nearest hit that comes before `best` (as [`comes_before`] orders
     /// them), if any: four triangles at a time in SIMD lanes, each lane
-    /// operation for operation as [`intersect_triangle`], and the lanes'
+    /// operation for operation as [`intersect_triangle`](super::intersect_triangle), and the lanes'
     /// hits then taken in index order against the bound the one-triangle
     /// loop would use, so that the answer is that loop's, bit for bit. A
     /// ray across the inside of a 1.1 M-triangle mesh tests about 19
@@ -482,16 +482,13 @@ impl Geometry {
         found
     }
 
-    /// Record `i`'s hit distance in (0, tmax), or infinity: from the compact
-    /// triangle copy when its leaf holds only triangles.
+    /// Record `i`'s hit distance in (0, tmax), or infinity, by its own
+    /// primitive's test: for leaves that hold something other than
+    /// triangles (leaves of triangles alone go four at a time, from the
+    /// compact copies).
     #[inline(always)]
-    pub(super) fn intersect_one(&self, i: usize, mixed: bool, o: Vec3, d: Vec3, tmax: f32) -> f32 {
-        if mixed {
-            self.records[i].prim.intersect(o, d, 0.0, tmax)
-        } else {
-            let [v0, e1, e2] = self.triangles[i];
-            intersect_triangle(v0, e1, e2, o, d, 0.0, tmax)
-        }
+    pub(super) fn intersect_one(&self, i: usize, o: Vec3, d: Vec3, tmax: f32) -> f32 {
+        self.records[i].prim.intersect(o, d, 0.0, tmax)
     }
 
     /// Whether any primitive is a signed distance field.

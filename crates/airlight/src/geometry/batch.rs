@@ -270,7 +270,7 @@ impl Geometry {
             for k in bits(rays) {
                 let (o, d) = p.ray(k);
                 for i in first..first + count {
-                    let t = self.intersect_one(i as usize, true, o, d, test_bound(p.tmax[k], p.id[k]));
+                    let t = self.intersect_one(i as usize, o, d, test_bound(p.tmax[k], p.id[k]));
                     if comes_before(t, i, p.tmax[k], p.id[k]) {
                         (p.tmax[k], p.id[k]) = (t, i);
                     }
@@ -308,7 +308,7 @@ impl Geometry {
         if mixed {
             for k in bits(rays) {
                 let (o, d) = p.ray(k);
-                if (first..first + count).any(|i| self.intersect_one(i as usize, true, o, d, p.tmax[k]) < p.tmax[k]) {
+                if (first..first + count).any(|i| self.intersect_one(i as usize, o, d, p.tmax[k]) < p.tmax[k]) {
                     blocked |= 1 << k;
                 }
             }
