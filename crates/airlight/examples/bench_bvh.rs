@@ -15,7 +15,7 @@
 //! walls of a room) and one out of it, one ray at a time and in packets
 //! (`tools/mitsuba_rays.py` traces the same through Mitsuba). Last, the
 //! camera and shadow rays through obvhs's compressed 8-wide BVH and its
-//! traversal (what Airlight used before the 4-wide tree), unless
+//! traversal (what Airlight used before its own wide tree), unless
 //! `--no-reference` is given. In between, the whole
 //! render of that image with the direct integrator (camera ray, shadow ray
 //! and shading; the scene of `tools/mesh_scene.py`) on all threads, with
@@ -155,7 +155,7 @@ fn main() {
         let pp = time(&rays, primary_with(lanes));
         let sp = time(&shadow, occluded_with(lanes));
         assert_eq!((pp.sum, sp.sum), (p.sum, s.sum), "{lanes:?}-lane packets and single rays disagree on hits");
-        report(&format!("Airlight BVH4, packets of coherent rays, {lanes:?} lanes"), &pp, &sp, threads);
+        report(&format!("Airlight BVH8, packets of coherent rays, {lanes:?} lanes"), &pp, &sp, threads);
         by_width.push((lanes, pp, sp));
     }
     let (widest, pp, sp) = &by_width[0];
@@ -166,7 +166,7 @@ fn main() {
             sp_n.one_cpu / sp.one_cpu
         );
     }
-    report("Airlight BVH4, one ray at a time", &p, &s, threads);
+    report("Airlight BVH8, one ray at a time", &p, &s, threads);
     println!("  {:.1}% of shadow rays blocked", 100.0 * s.sum as f64 / shadow.len() as f64);
     println!(
         "packets against one ray at a time, per CPU second, 1 thread: primary {:.2}×, shadow {:.2}×",

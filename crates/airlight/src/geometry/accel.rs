@@ -1,11 +1,13 @@
 //! The scene's geometry as flat primitives under one BVH (built by obvhs,
-//! flattened into a 4-wide tree traversed with SIMD box tests, see
-//! `bvh4.rs`), plus infinite planes, which no bounding box holds and which
+//! flattened into an 8-wide tree traversed with SIMD box tests, see
+//! `bvh.rs`), plus infinite planes, which no bounding box holds and which
 //! are tested one by one.
 
 use super::Ray;
 use super::batch::{comes_before, test_bound};
-use super::bvh4::{self, BoxRay, Bvh4};
+use super::bvh::{BoxRay, Bvh8};
+#[cfg(target_arch = "x86_64")]
+use super::lanes::{Avx8, has_avx};
 use super::lanes::{Lanes, NativeLanes};
 use super::packet::{triangle_hits, triangle_terms};
 use super::quad_lanes::QuadLanes;
@@ -75,7 +77,7 @@ pub struct Geometry {
     /// the compact copy that traversal reads, one 36-byte entry per record.
     pub(super) triangles: Vec<[Vec3; 3]>,
     /// None when there are few primitives: testing them all is faster.
-    bvh: Option<Bvh4>,
+    bvh: Option<Bvh8>,
     /// A small scene of quads and a few other primitives: the quads in
     /// SIMD lanes and the other records' indices, tested all at once for
     /// single rays instead of through `bvh` (which packets still use).
@@ -204,11 +206,11 @@ impl GeometryBuilder {
         let mixed = |first: u32, count: u32| {
             records[first as usize..(first + count) as usize].iter().any(|r| !matches!(r.prim, Prim::Triangle { .. }))
         };
-        let bvh = Bvh4::from_bvh2(&bvh2, mixed);
+        let bvh = Bvh8::from_bvh2(&bvh2, mixed);
         // Many primitives with the same bounds (duplicated objects or faces)
         // can make the tree deeper than the traversal's fixed stack: such
         // scenes are searched linearly instead, slow but right.
-        if bvh.depth() > bvh4::MAX_DEPTH {
+        if bvh.depth() > Bvh8::MAX_DEPTH {
             return Geometry { records, planes, unbounded, triangles, bvh: None, small: None, bounds, triangle_uvs };
         }
         let small = small_scene(&records);
@@ -316,27 +318,7 @@ impl Geometry {
         } else {
             match &self.bvh {
                 Some(bvh) => {
-                    let (o, d) = (ray.origin, ray.dir);
-                    let box_ray = BoxRay::new(o.to_array(), d.to_array());
-                    let found = bvh.closest(
-                        &box_ray,
-                        tmax,
-                        |first, count, mixed, (mut best_t, mut best_id)| {
-                            if !mixed {
-                                return self.leaf_nearest(first, count, o, d, (best_t, best_id));
-                            }
-                            let mut found = None;
-                            for i in first..first + count {
-                                let t = self.intersect_one(i as usize, o, d, test_bound(best_t, best_id));
-                                if comes_before(t, i, best_t, best_id) {
-                                    (best_t, best_id) = (t, i);
-                                    found = Some((t, i));
-                                }
-                            }
-                            found
-                        },
-                        |first, count| self.prefetch_triangles(first, count),
-                    );
+                    let found = self.nearest_in_tree(bvh, ray.origin, ray.dir, tmax);
                     if let Some((t, id)) = found {
                         best = Hit { t, id };
                     }
@@ -353,6 +335,52 @@ impl Geometry {
         }
         self.intersect_unbounded(ray, &mut best);
         (best.id != u32::MAX).then_some(best)
+    }
+
+    /// The nearest (t, primitive) in the tree on the segment (0, tmax),
+    /// with the box tests eight at a time where the processor has AVX.
+    #[inline]
+    fn nearest_in_tree(&self, bvh: &Bvh8, o: Vec3, d: Vec3, tmax: f32) -> Option<(f32, u32)> {
+        #[cfg(target_arch = "x86_64")]
+        if has_avx() {
+            // SAFETY: the processor has AVX.
+            return unsafe { self.nearest_in_tree_avx(bvh, o, d, tmax) };
+        }
+        self.nearest_in_tree_with::<NativeLanes>(bvh, o, d, tmax)
+    }
+
+    /// [`Geometry::nearest_in_tree`] compiled for AVX.
+    ///
+    /// # Safety
+    /// The processor must have AVX.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx")]
+    unsafe fn nearest_in_tree_avx(&self, bvh: &Bvh8, o: Vec3, d: Vec3, tmax: f32) -> Option<(f32, u32)> {
+        self.nearest_in_tree_with::<Avx8>(bvh, o, d, tmax)
+    }
+
+    #[inline(always)]
+    fn nearest_in_tree_with<B: Lanes>(&self, bvh: &Bvh8, o: Vec3, d: Vec3, tmax: f32) -> Option<(f32, u32)> {
+        let box_ray = BoxRay::new(o.to_array(), d.to_array());
+        bvh.closest::<B>(
+            &box_ray,
+            tmax,
+            |first, count, mixed, (mut best_t, mut best_id)| {
+                if !mixed {
+                    return self.leaf_nearest(first, count, o, d, (best_t, best_id));
+                }
+                let mut found = None;
+                for i in first..first + count {
+                    let t = self.intersect_one(i as usize, o, d, test_bound(best_t, best_id));
+                    if comes_before(t, i, best_t, best_id) {
+                        (best_t, best_id) = (t, i);
+                        found = Some((t, i));
+                    }
+                }
+                found
+            },
+            |first, count| self.prefetch_triangles(first, count),
+        )
     }
 
     /// Planes and unbounded SDFs, tested one by one after the bounded primitives.
@@ -387,15 +415,34 @@ impl Geometry {
                 });
         }
         match &self.bvh {
-            Some(bvh) => self.occluded_bvh(bvh, origin, dir, tmax),
+            Some(bvh) => {
+                #[cfg(target_arch = "x86_64")]
+                if has_avx() {
+                    // SAFETY: the processor has AVX.
+                    return unsafe { self.occluded_bvh_avx(bvh, origin, dir, tmax) };
+                }
+                self.occluded_bvh::<NativeLanes>(bvh, origin, dir, tmax)
+            }
             None => self.occluded_linear(origin, dir, tmax),
         }
     }
 
-    /// Whether a primitive in the tree blocks the segment.
-    pub(super) fn occluded_bvh(&self, bvh: &Bvh4, origin: Vec3, dir: Vec3, tmax: f32) -> bool {
+    /// [`Geometry::occluded_bvh`] compiled for AVX.
+    ///
+    /// # Safety
+    /// The processor must have AVX.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx")]
+    unsafe fn occluded_bvh_avx(&self, bvh: &Bvh8, origin: Vec3, dir: Vec3, tmax: f32) -> bool {
+        self.occluded_bvh::<Avx8>(bvh, origin, dir, tmax)
+    }
+
+    /// Whether a primitive in the tree blocks the segment, with the box
+    /// tests `B::WIDTH` at a time.
+    #[inline(always)]
+    pub(super) fn occluded_bvh<B: Lanes>(&self, bvh: &Bvh8, origin: Vec3, dir: Vec3, tmax: f32) -> bool {
         let box_ray = BoxRay::new(origin.to_array(), dir.to_array());
-        bvh.any(&box_ray, tmax, |first, count, mixed| {
+        bvh.any::<B>(&box_ray, tmax, |first, count, mixed| {
             (first..first + count).any(|i| {
                 if mixed {
                     self.records[i as usize].prim.intersect(origin, dir, 0.0, tmax) < tmax
@@ -413,7 +460,7 @@ impl Geometry {
     }
 
     /// The tree, if the scene has one.
-    pub(super) fn bvh(&self) -> Option<&Bvh4> {
+    pub(super) fn bvh(&self) -> Option<&Bvh8> {
         self.bvh.as_ref()
     }
 

@@ -221,7 +221,7 @@ impl Geometry {
                 if indices.len() < MIN_PACKET {
                     for &i in indices {
                         let s = &segments[i];
-                        blocked[i] = blocked[i] || self.occluded_bvh(bvh, s.origin, s.dir, s.tmax);
+                        blocked[i] = blocked[i] || self.occluded_bvh::<L::Four>(bvh, s.origin, s.dir, s.tmax);
                     }
                     return;
                 }

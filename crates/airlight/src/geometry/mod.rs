@@ -2,7 +2,7 @@
 
 mod accel;
 mod batch;
-mod bvh4;
+mod bvh;
 mod lanes;
 mod packet;
 mod quad_lanes;

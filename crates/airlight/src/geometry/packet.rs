@@ -1,5 +1,5 @@
-//! Packets of up to 64 coherent rays traced together through the 4-wide BVH
-//! (`bvh4.rs`), for camera rays of neighbouring pixels and shadow rays from
+//! Packets of up to 64 coherent rays traced together through the 8-wide BVH
+//! (`bvh.rs`), for camera rays of neighbouring pixels and shadow rays from
 //! them toward one light.
 //!
 //! Each node is fetched once for the whole packet. Its four child boxes are
@@ -22,7 +22,7 @@
 //! for all of them. The arithmetic is written once over [`Lanes`]
 //! (`lanes.rs`).
 
-use super::bvh4::{Bvh4, COUNT_MASK, FAR_SCALE, LEAF_MIXED, Node4, STACK_SIZE, far_row};
+use super::bvh::{Bvh, COUNT_MASK, FAR_SCALE, LEAF_MIXED, Node, STACK_SIZE, far_row};
 use super::lanes::Lanes;
 use glam::Vec3;
 
@@ -36,7 +36,7 @@ pub const PACKET: usize = 64;
 pub struct Packet {
     pub origin: [[f32; PACKET]; 3],
     pub dir: [[f32; PACKET]; 3],
-    /// Reciprocal directions, zeros replaced as in [`super::bvh4::BoxRay`].
+    /// Reciprocal directions, zeros replaced as in [`super::bvh::BoxRay`].
     inv_dir: [[f32; PACKET]; 3],
     pub tmax: [f32; PACKET],
     pub id: [u32; PACKET],
@@ -154,7 +154,7 @@ impl Packet {
     /// Of the rays in `mask`, those whose segment [0, tmax] enters child
     /// `c`'s box of `node`: the single-ray test, `L::WIDTH` rays at a time.
     #[inline(always)]
-    fn enter<L: Lanes>(&self, node: &Node4, c: usize, mask: u64) -> u64 {
+    fn enter<L: Lanes, const W: usize>(&self, node: &Node<W>, c: usize, mask: u64) -> u64 {
         let mut out = 0;
         let mut groups = mask;
         while groups != 0 {
@@ -184,10 +184,10 @@ impl Packet {
     /// the values each ray's own test computes, and no child that a ray
     /// enters is dropped.
     #[inline(always)]
-    fn children<L: Lanes>(&self, node: &Node4) -> (u32, [f32; 4]) {
+    fn children<L: Lanes, const W: usize>(&self, node: &Node<W>, at: usize) -> (u32, [f32; 4]) {
         debug_assert_eq!(L::WIDTH, 4, "one lane per child");
         let range = |row: usize, a: usize| {
-            let plane = L::load(&node.bounds[row]);
+            let plane = L::load(&node.bounds[row][at..]);
             let (d_lo, d_hi) = (plane.sub(L::splat(self.origin_hi[a])), plane.sub(L::splat(self.origin_lo[a])));
             let (i_lo, i_hi) = (L::splat(self.inv_lo[a]), L::splat(self.inv_hi[a]));
             let (p0, p1, p2, p3) = (d_lo.mul(i_lo), d_lo.mul(i_hi), d_hi.mul(i_lo), d_hi.mul(i_hi));
@@ -307,7 +307,7 @@ struct Entry {
     mask: u64,
 }
 
-impl Bvh4 {
+impl<const W: usize> Bvh<W> {
     /// Traces the rays of `mask` in `packet` through the tree. `leaf(first,
     /// count, mixed, rays, packet)` tests a leaf's primitives against the
     /// rays `rays` (those that enter its box), updates their `tmax` and `id`
@@ -334,9 +334,15 @@ impl Bvh4 {
         loop {
             if let Some((index, rays)) = expand.take() {
                 let node = &self.nodes[index];
-                let (bits, tnear) = packet.children::<L::Four>(node);
+                let mut bits = 0;
+                let mut tnear = [0.0f32; W];
+                for q in 0..W / 4 {
+                    let (b, t) = packet.children::<L::Four, W>(node, 4 * q);
+                    bits |= b << (4 * q);
+                    tnear[4 * q..4 * q + 4].copy_from_slice(&t);
+                }
                 // Push the farthest first, so that the nearest is popped first.
-                let mut order = [(0usize, 0.0f32); 4];
+                let mut order = [(0usize, 0.0f32); W];
                 let mut n = 0;
                 let mut b = bits;
                 while b != 0 {
@@ -369,7 +375,7 @@ impl Bvh4 {
             let e = stack[top];
             let parent = &self.nodes[e.node as usize];
             let slot = e.slot as usize;
-            let rays = packet.enter::<L>(parent, slot, e.mask & alive);
+            let rays = packet.enter::<L, W>(parent, slot, e.mask & alive);
             if rays == 0 {
                 continue;
             }

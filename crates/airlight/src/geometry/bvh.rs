@@ -1,27 +1,37 @@
-//! A 4-wide BVH traversed with SIMD box tests: obvhs builds a binary tree
+//! A wide BVH traversed with SIMD box tests: obvhs builds a binary tree
 //! (PLOC, reinsertion, SAH leaf collapse), which is flattened here into nodes
-//! of four children whose boxes are stored as structure of arrays, so that
-//! one node is two cache lines and its four slab tests are a handful of
-//! SSE instructions (x86-64 always has SSE2; other targets use a scalar loop
-//! with the same arithmetic).
+//! of eight children whose boxes are stored as structure of arrays, so that
+//! one node is four cache lines and its eight slab tests are a handful of
+//! AVX instructions (or twice as many SSE ones where the processor has no
+//! AVX; every lane type does the same IEEE operations, so the hits do not
+//! depend on the processor).
+//!
+//! Why eight children rather than four: a ray descends half as many levels,
+//! and each level is a wait on memory when the tree and triangles exceed
+//! the cache. On a 1.1 M-triangle mesh, one ray at a time, incoherent rays
+//! across its inside ran 1.25× as fast with eight as with four, camera and
+//! shadow rays about 1.2×, and packets of coherent rays the same
+//! (BENCHMARKS.md has the figures). The width is a parameter of the types
+//! so that tests can compare trees of both widths.
 //!
 //! Why not obvhs's own traversal of its compressed 8-wide BVH: on a 1.1 M
 //! triangle mesh it reached 1.6 M rays/s per core, its cost in decoding the
 //! quantised child boxes one by one (BENCHMARKS.md has the figures).
 
+use super::lanes::Lanes;
 use obvhs::bvh2::Bvh2;
 
-/// Four children's boxes and links. A child slot is a leaf if its count is
+/// W children's boxes and links. A child slot is a leaf if its count is
 /// non-zero (`child` is then the first primitive, `count & COUNT_MASK` the
 /// number of primitives), an inner node if its count is zero, and empty if
 /// its box is empty (min = +∞, max = −∞, which no ray hits).
 #[derive(Clone, Copy, Debug)]
 #[repr(C, align(64))]
-pub(super) struct Node4 {
-    /// min x, min y, min z, max x, max y, max z, each for four children.
-    pub(super) bounds: [[f32; 4]; 6],
-    pub(super) child: [u32; 4],
-    pub(super) count: [u32; 4],
+pub(super) struct Node<const W: usize> {
+    /// min x, min y, min z, max x, max y, max z, each for W children.
+    pub(super) bounds: [[f32; W]; 6],
+    pub(super) child: [u32; W],
+    pub(super) count: [u32; W],
 }
 
 /// Set in a leaf's count when one of its primitives is not a triangle, so
@@ -29,31 +39,35 @@ pub(super) struct Node4 {
 pub const LEAF_MIXED: u32 = 1 << 31;
 pub(super) const COUNT_MASK: u32 = !LEAF_MIXED;
 
-/// Entries the traversal stack holds: three per level below the root, plus one.
-pub(super) const STACK_SIZE: usize = 192;
-/// The deepest tree the stack can hold.
-pub const MAX_DEPTH: usize = (STACK_SIZE - 1) / 3;
+/// Entries the traversal stack holds: W − 1 per level below the root, plus
+/// one (`Bvh::MAX_DEPTH`).
+pub(super) const STACK_SIZE: usize = 256;
 
-const EMPTY: Node4 = Node4 {
-    bounds: [
-        [f32::INFINITY; 4],
-        [f32::INFINITY; 4],
-        [f32::INFINITY; 4],
-        [f32::NEG_INFINITY; 4],
-        [f32::NEG_INFINITY; 4],
-        [f32::NEG_INFINITY; 4],
-    ],
-    child: [u32::MAX; 4],
-    count: [0; 4],
-};
+impl<const W: usize> Node<W> {
+    const EMPTY: Self = Node {
+        bounds: [
+            [f32::INFINITY; W],
+            [f32::INFINITY; W],
+            [f32::INFINITY; W],
+            [f32::NEG_INFINITY; W],
+            [f32::NEG_INFINITY; W],
+            [f32::NEG_INFINITY; W],
+        ],
+        child: [u32::MAX; W],
+        count: [0; W],
+    };
+}
 
 /// The flattened tree. Primitive indices in leaves are positions in the
 /// obvhs tree's `primitive_indices` order.
 #[derive(Clone, Debug)]
-pub struct Bvh4 {
-    pub(super) nodes: Vec<Node4>,
+pub struct Bvh<const W: usize> {
+    pub(super) nodes: Vec<Node<W>>,
     depth: usize,
 }
+
+/// The tree the geometry uses: eight children a node.
+pub type Bvh8 = Bvh<8>;
 
 /// A ray prepared for box tests: which bound is near on each axis, the
 /// origin, and the reciprocal direction with zeros replaced by tiny values
@@ -83,51 +97,29 @@ impl BoxRay {
 /// box the ray grazes (Ize, "Robust BVH ray traversal", 2013).
 pub(super) const FAR_SCALE: f32 = 1.0 + 4.0 * f32::EPSILON;
 
-/// The entry distances of the four children and a bit mask of those the ray
-/// segment [0, tmax] enters.
+/// The entry distances of the W children and a bit mask of those the ray
+/// segment [0, tmax] enters, `B::WIDTH` children at a time (eight in one
+/// AVX register, or four in an SSE one). Every lane type does the same
+/// IEEE operations, so the answer does not depend on the processor.
 #[inline(always)]
-fn hit4(node: &Node4, ray: &BoxRay, tmax: f32) -> (u32, [f32; 4]) {
-    #[cfg(target_arch = "x86_64")]
-    // SAFETY: SSE and SSE2 are part of the x86-64 baseline; the loads read
-    // the node's 16-byte aligned rows (the node is 64-byte aligned and each
-    // row is 16 bytes).
-    unsafe {
-        use std::arch::x86_64::*;
-        let b = &node.bounds;
+fn hit<B: Lanes, const W: usize>(node: &Node<W>, ray: &BoxRay, tmax: f32) -> (u32, [f32; W]) {
+    debug_assert_eq!(W % B::WIDTH, 0, "whole lane groups per node");
+    let mut mask = 0;
+    let mut out = [0.0f32; W];
+    let mut at = 0;
+    while at < W {
         let slab = |row: usize, axis: usize| {
-            let plane = _mm_load_ps(b[row].as_ptr());
-            _mm_mul_ps(_mm_sub_ps(plane, _mm_set1_ps(ray.origin[axis])), _mm_set1_ps(ray.inv_dir[axis]))
+            B::load(&node.bounds[row][at..]).sub(B::splat(ray.origin[axis])).mul(B::splat(ray.inv_dir[axis]))
         };
         let n = [slab(ray.near[0], 0), slab(ray.near[1], 1), slab(ray.near[2], 2)];
         let f = [slab(far_row(ray.near[0], 0), 0), slab(far_row(ray.near[1], 1), 1), slab(far_row(ray.near[2], 2), 2)];
-        let tnear = _mm_max_ps(_mm_max_ps(n[0], n[1]), _mm_max_ps(n[2], _mm_setzero_ps()));
-        let tfar = _mm_min_ps(_mm_min_ps(f[0], f[1]), _mm_min_ps(f[2], _mm_set1_ps(tmax)));
-        let tfar = _mm_mul_ps(tfar, _mm_set1_ps(FAR_SCALE));
-        let mask = _mm_movemask_ps(_mm_cmple_ps(tnear, tfar)) as u32;
-        let mut out = [0.0f32; 4];
-        _mm_storeu_ps(out.as_mut_ptr(), tnear);
-        (mask, out)
+        let tnear = n[0].max(n[1]).max(n[2].max(B::splat(0.0)));
+        let tfar = f[0].min(f[1]).min(f[2].min(B::splat(tmax))).mul(B::splat(FAR_SCALE));
+        mask |= tnear.le(tfar) << at;
+        out[at..at + B::WIDTH].copy_from_slice(tnear.to_array().as_ref());
+        at += B::WIDTH;
     }
-    #[cfg(not(target_arch = "x86_64"))]
-    {
-        let mut mask = 0;
-        let mut out = [0.0f32; 4];
-        for c in 0..4 {
-            let mut tnear = 0.0f32;
-            let mut tfar = tmax;
-            for a in 0..3 {
-                let n = (node.bounds[ray.near[a]][c] - ray.origin[a]) * ray.inv_dir[a];
-                let f = (node.bounds[far_row(ray.near[a], a)][c] - ray.origin[a]) * ray.inv_dir[a];
-                tnear = tnear.max(n);
-                tfar = tfar.min(f);
-            }
-            if tnear <= tfar * FAR_SCALE {
-                mask |= 1 << c;
-            }
-            out[c] = tnear;
-        }
-        (mask, out)
-    }
+    (mask, out)
 }
 
 /// The row of the far plane on an axis, given the near plane's row.
@@ -144,8 +136,8 @@ struct Entry {
     tnear: f32,
 }
 
-/// The traversal stack, left uninitialised: zeroing 2 KB per ray cost more
-/// than the traversal of a coherent ray.
+/// The traversal stack, left uninitialised: zeroing its 3 KB per ray would
+/// cost more than the traversal of a coherent ray.
 struct Stack {
     entries: [std::mem::MaybeUninit<Entry>; STACK_SIZE],
     top: usize,
@@ -157,7 +149,7 @@ impl Stack {
         Stack { entries: [std::mem::MaybeUninit::uninit(); STACK_SIZE], top: 0 }
     }
 
-    /// Pushes an entry; the tree's depth (checked at build, `MAX_DEPTH`)
+    /// Pushes an entry; the tree's depth (checked at build, `Bvh::MAX_DEPTH`)
     /// bounds the entries, and an overflow panics rather than corrupts.
     #[inline(always)]
     fn push(&mut self, e: Entry) {
@@ -176,18 +168,21 @@ impl Stack {
     }
 }
 
-impl Bvh4 {
+impl<const W: usize> Bvh<W> {
+    /// The deepest tree the traversal stack can hold.
+    pub const MAX_DEPTH: usize = (STACK_SIZE - 1) / (W - 1);
+
     /// Flattens an obvhs binary tree. Each node takes the two children of a
     /// binary node and then repeatedly splits its largest inner child into
-    /// that child's two children, until it has four. Nodes are laid out
+    /// that child's two children, until it has W. Nodes are laid out
     /// depth first (a node, then the whole subtree of its first inner
     /// child, then of its second, …): against siblings side by side,
     /// incoherent rays out of a 1.1 M-triangle mesh ran 1.12× as fast and
-    /// rays across its inside 1.05× (bench_bvh, 4 side-by-side pairs each),
-    /// with the same tree and so the same hits.
+    /// rays across its inside 1.05× (bench_bvh, 4 side-by-side pairs each,
+    /// measured on four-wide trees), with the same tree and so the same hits.
     pub fn from_bvh2(bvh2: &Bvh2, mixed: impl Fn(u32, u32) -> bool) -> Self {
-        let mut nodes = Vec::with_capacity(bvh2.nodes.len() / 2 + 1);
-        nodes.push(EMPTY);
+        let mut nodes = Vec::with_capacity(bvh2.nodes.len() / (2 * (W - 1)) + 1);
+        nodes.push(Node::EMPTY);
         let root = &bvh2.nodes[0];
         let mut depth = 1;
         if root.is_leaf() {
@@ -202,7 +197,7 @@ impl Bvh4 {
                 let slot = match parent {
                     None => 0,
                     Some((p, c)) => {
-                        nodes.push(EMPTY);
+                        nodes.push(Node::EMPTY);
                         let index = nodes.len() - 1;
                         nodes[p].child[c] = index as u32;
                         index
@@ -212,7 +207,7 @@ impl Bvh4 {
                     let f = bvh2.nodes[b2].first_index as usize;
                     vec![f, f + 1]
                 };
-                while kids.len() < 4 {
+                while kids.len() < W {
                     let widest = kids
                         .iter()
                         .enumerate()
@@ -235,7 +230,7 @@ impl Bvh4 {
                 }
             }
         }
-        Bvh4 { nodes, depth }
+        Bvh { nodes, depth }
     }
 
     /// Levels of nodes, the root's included.
@@ -254,7 +249,7 @@ impl Bvh4 {
     /// memory most of their time, and rays across the inside of a 1.1 M
     /// triangle mesh ran 1.2× as fast so (child nodes are fetched ahead too).
     #[inline]
-    pub fn closest(
+    pub fn closest<B: Lanes>(
         &self,
         ray: &BoxRay,
         tmax: f32,
@@ -275,8 +270,8 @@ impl Bvh4 {
                 }
             } else {
                 let node = &self.nodes[current.child as usize];
-                let (mask, tnear) = hit4(node, ray, best_t);
-                let mut hits = [Entry { child: 0, count: 0, tnear: 0.0 }; 4];
+                let (mask, tnear) = hit::<B, W>(node, ray, best_t);
+                let mut hits = [Entry { child: 0, count: 0, tnear: 0.0 }; W];
                 let mut n = 0;
                 let mut bits = mask;
                 while bits != 0 {
@@ -320,7 +315,7 @@ impl Bvh4 {
     /// Whether `leaf(first, count, mixed)` finds a hit in any leaf that the
     /// segment (0, tmax) enters; stops at the first.
     #[inline]
-    pub fn any(&self, ray: &BoxRay, tmax: f32, mut leaf: impl FnMut(u32, u32, bool) -> bool) -> bool {
+    pub fn any<B: Lanes>(&self, ray: &BoxRay, tmax: f32, mut leaf: impl FnMut(u32, u32, bool) -> bool) -> bool {
         let mut stack = Stack::new();
         stack.push(Entry { child: 0, count: 0, tnear: 0.0 });
         while let Some(current) = stack.pop() {
@@ -331,7 +326,7 @@ impl Bvh4 {
                 continue;
             }
             let node = &self.nodes[current.child as usize];
-            let (mut bits, _) = hit4(node, ray, tmax);
+            let (mut bits, _) = hit::<B, W>(node, ray, tmax);
             while bits != 0 {
                 let c = bits.trailing_zeros() as usize;
                 bits &= bits - 1;
@@ -348,7 +343,14 @@ fn area(bvh2: &Bvh2, node: usize) -> f32 {
 
 /// Fills child slot `c` of `node` from binary node `k`: an inner child at
 /// `inner`, or (if `inner` is u32::MAX) a leaf.
-fn set_child(node: &mut Node4, c: usize, bvh2: &Bvh2, k: usize, inner: u32, mixed: &impl Fn(u32, u32) -> bool) {
+fn set_child<const W: usize>(
+    node: &mut Node<W>,
+    c: usize,
+    bvh2: &Bvh2,
+    k: usize,
+    inner: u32,
+    mixed: &impl Fn(u32, u32) -> bool,
+) {
     let b = bvh2.nodes[k].aabb();
     for a in 0..3 {
         node.bounds[a][c] = b.min[a];
@@ -362,5 +364,146 @@ fn set_child(node: &mut Node4, c: usize, bvh2: &Bvh2, k: usize, inner: u32, mixe
     } else {
         node.child[c] = inner;
         node.count[c] = 0;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::lanes::{NativeLanes, Scalar4};
+    use crate::geometry::shape::intersect_triangle;
+    use glam::{Vec3, Vec3A};
+    use obvhs::{BvhBuildParams, triangle::Triangle};
+    use std::time::Duration;
+
+    /// Numbers in [0, 1) from a fixed xorshift sequence.
+    fn uniform(state: &mut u32) -> f32 {
+        *state ^= *state << 13;
+        *state ^= *state >> 17;
+        *state ^= *state << 5;
+        (*state >> 8) as f32 / (1u32 << 24) as f32
+    }
+
+    /// Small triangles scattered through the unit cube, the binary tree
+    /// over them, and their vertices in the tree's leaf order.
+    fn scene() -> (Bvh2, Vec<[Vec3; 3]>) {
+        let mut state = 0x1234_5678;
+        let mut point = |scale: f32| Vec3::new(uniform(&mut state), uniform(&mut state), uniform(&mut state)) * scale;
+        let triangles: Vec<Triangle> = (0..1000)
+            .map(|_| {
+                let v0 = point(1.0);
+                let (a, b) = (point(0.3) - 0.15, point(0.3) - 0.15);
+                Triangle { v0: v0.into(), v1: Vec3A::from(v0 + a), v2: Vec3A::from(v0 + b) }
+            })
+            .collect();
+        let bvh2 =
+            obvhs::bvh2::builder::build_bvh2(&triangles, BvhBuildParams::medium_build(), &mut Duration::default());
+        let ordered = bvh2
+            .primitive_indices
+            .iter()
+            .map(|&i| {
+                let t = &triangles[i as usize];
+                [t.v0, t.v1, t.v2].map(Vec3::from)
+            })
+            .collect();
+        (bvh2, ordered)
+    }
+
+    /// The nearest hit of all triangles on (0, ∞), ties to the lowest index.
+    fn nearest_of_all(triangles: &[[Vec3; 3]], o: Vec3, d: Vec3) -> Option<(f32, u32)> {
+        let mut best = None;
+        for (i, [v0, v1, v2]) in triangles.iter().enumerate() {
+            let t = intersect_triangle(*v0, *v1 - *v0, *v2 - *v0, o, d, 0.0, f32::INFINITY);
+            if t < best.map_or(f32::INFINITY, |b: (f32, u32)| b.0) {
+                best = Some((t, i as u32));
+            }
+        }
+        best
+    }
+
+    /// The tree's nearest hit, with box tests on lanes `B`.
+    fn nearest<B: Lanes, const W: usize>(
+        bvh: &Bvh<W>,
+        triangles: &[[Vec3; 3]],
+        o: Vec3,
+        d: Vec3,
+    ) -> Option<(f32, u32)> {
+        let ray = BoxRay::new(o.to_array(), d.to_array());
+        let leaf = |first: u32, count: u32, _mixed: bool, (mut best_t, mut best_id): (f32, u32)| {
+            let mut found = None;
+            for i in first..first + count {
+                let [v0, v1, v2] = triangles[i as usize];
+                let t = intersect_triangle(v0, v1 - v0, v2 - v0, o, d, 0.0, f32::INFINITY);
+                if t < f32::INFINITY && (t < best_t || (t == best_t && i < best_id)) {
+                    (best_t, best_id) = (t, i);
+                    found = Some((t, i));
+                }
+            }
+            found
+        };
+        bvh.closest::<B>(&ray, f32::INFINITY, leaf, |_, _| {})
+    }
+
+    /// Whether the tree finds a triangle on (0, tmax), box tests on lanes `B`.
+    fn blocked<B: Lanes, const W: usize>(bvh: &Bvh<W>, triangles: &[[Vec3; 3]], o: Vec3, d: Vec3, tmax: f32) -> bool {
+        let ray = BoxRay::new(o.to_array(), d.to_array());
+        bvh.any::<B>(&ray, tmax, |first, count, _| {
+            (first..first + count).any(|i| {
+                let [v0, v1, v2] = triangles[i as usize];
+                intersect_triangle(v0, v1 - v0, v2 - v0, o, d, 0.0, tmax) < tmax
+            })
+        })
+    }
+
+    /// Every tree width and lane type against a test of every triangle:
+    /// the same nearest hit (distance and triangle) and the same answer to
+    /// "is the segment blocked", over rays from inside and around the cube.
+    fn check<B: Lanes, const W: usize>(bvh2: &Bvh2, triangles: &[[Vec3; 3]]) -> usize {
+        let bvh = Bvh::<W>::from_bvh2(bvh2, |_, _| false);
+        assert!(bvh.depth() <= Bvh::<W>::MAX_DEPTH);
+        let mut state = 0x9e37_79b9;
+        let mut hits = 0;
+        for _ in 0..3000 {
+            let o = Vec3::new(uniform(&mut state), uniform(&mut state), uniform(&mut state)) * 1.4 - 0.2;
+            let d = (Vec3::new(uniform(&mut state), uniform(&mut state), uniform(&mut state)) * 2.0 - 1.0).normalize();
+            let expected = nearest_of_all(triangles, o, d);
+            assert_eq!(nearest::<B, W>(&bvh, triangles, o, d), expected, "W = {W}, ray {o} {d}");
+            let tmax = uniform(&mut state) * 1.5;
+            let expected_blocked = triangles
+                .iter()
+                .any(|[v0, v1, v2]| intersect_triangle(*v0, *v1 - *v0, *v2 - *v0, o, d, 0.0, tmax) < tmax);
+            assert_eq!(
+                blocked::<B, W>(&bvh, triangles, o, d, tmax),
+                expected_blocked,
+                "W = {W}, ray {o} {d} to {tmax}"
+            );
+            hits += expected.is_some() as usize;
+        }
+        hits
+    }
+
+    #[test]
+    fn trees_of_four_and_eight_find_what_a_test_of_every_triangle_finds() {
+        let (bvh2, triangles) = scene();
+        let hits = check::<Scalar4, 4>(&bvh2, &triangles);
+        // Enough rays hit and miss for the comparison to mean something.
+        assert!((500..2500).contains(&hits), "{hits} of 3000 rays hit");
+        check::<NativeLanes, 4>(&bvh2, &triangles);
+        check::<Scalar4, 8>(&bvh2, &triangles);
+        check::<NativeLanes, 8>(&bvh2, &triangles);
+        #[cfg(target_arch = "x86_64")]
+        {
+            use crate::geometry::lanes::{Avx8, has_avx};
+            if has_avx() {
+                #[target_feature(enable = "avx")]
+                unsafe fn with_avx(bvh2: &Bvh2, triangles: &[[Vec3; 3]]) {
+                    check::<Avx8, 8>(bvh2, triangles);
+                }
+                // SAFETY: the processor has AVX (checked above).
+                unsafe { with_avx(&bvh2, &triangles) };
+            } else {
+                eprintln!("AVX lanes skipped: this processor has no AVX");
+            }
+        }
     }
 }
