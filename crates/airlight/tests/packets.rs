@@ -74,6 +74,12 @@ fn agree(geometry: &Geometry, rays: &[Ray], tmax: f32, shadow: &[Segment], check
     for (i, r) in rays.iter().enumerate().step_by((rays.len() / check_brute.max(1)).max(1)) {
         assert_eq!(single[i], geometry.intersect_brute_force(r, tmax), "ray {i}: {r:?}");
     }
+    // One ray at a time on each lane width: the same answers.
+    for lanes in LaneWidth::ALL.into_iter().filter(|l| l.available()) {
+        for (i, r) in rays.iter().enumerate() {
+            assert_eq!(geometry.intersect_on(lanes, r, tmax), single[i], "ray {i} (one, {lanes:?} lanes): {r:?}");
+        }
+    }
     for lanes in LaneWidth::ALL.into_iter().filter(|l| l.available()) {
         let mut packets = vec![None; rays.len()];
         geometry.intersect_packet_on(lanes, rays, tmax, &mut packets);
@@ -86,6 +92,10 @@ fn agree(geometry: &Geometry, rays: &[Ray], tmax: f32, shadow: &[Segment], check
     assert_eq!(widest, single);
     let hits = single.iter().filter(|h| h.is_some()).count();
     let single: Vec<bool> = shadow.iter().map(|s| geometry.occluded(s.origin, s.dir, s.tmax)).collect();
+    for lanes in LaneWidth::ALL.into_iter().filter(|l| l.available()) {
+        let one: Vec<bool> = shadow.iter().map(|s| geometry.occluded_on(lanes, s.origin, s.dir, s.tmax)).collect();
+        assert_eq!(one, single, "one ray at a time, {lanes:?} lanes");
+    }
     for lanes in LaneWidth::ALL.into_iter().filter(|l| l.available()) {
         let mut packets = vec![false; shadow.len()];
         geometry.occluded_packet_on(lanes, shadow, &mut packets);

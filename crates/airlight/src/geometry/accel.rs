@@ -8,7 +8,7 @@ use super::batch::{comes_before, test_bound};
 use super::bvh::{BoxRay, Bvh8};
 #[cfg(target_arch = "x86_64")]
 use super::lanes::{Avx8, has_avx};
-use super::lanes::{Lanes, NativeLanes};
+use super::lanes::{LaneWidth, Lanes, NativeLanes, Scalar4};
 use super::packet::{triangle_hits, triangle_terms};
 use super::quad_lanes::QuadLanes;
 use super::records::{
@@ -218,6 +218,35 @@ impl GeometryBuilder {
     }
 }
 
+/// A vector in lanes, the same in each. (Functions rather than closures
+/// here: a closure is compiled without the target features of the
+/// function it is written in, and where it is not inlined its AVX lanes
+/// become calls.)
+#[inline(always)]
+fn splat<L: Lanes>(v: Vec3) -> [L; 3] {
+    [L::splat(v.x), L::splat(v.y), L::splat(v.z)]
+}
+
+/// Triangles' stored (v0, e1, e2) in lanes, lane k from `group[k]`. Lanes
+/// past the group's last triangle hold a degenerate one (zero edges: no
+/// determinant), which never hits.
+#[inline(always)]
+fn gather<L: Lanes>(group: &[[Vec3; 3]]) -> [[L; 3]; 3] {
+    let mut rows = [[0.0f32; 16]; 9];
+    for (k, triangle) in group.iter().enumerate() {
+        for (v, vector) in triangle.iter().enumerate() {
+            rows[3 * v][k] = vector.x;
+            rows[3 * v + 1][k] = vector.y;
+            rows[3 * v + 2][k] = vector.z;
+        }
+    }
+    [
+        [L::load(&rows[0]), L::load(&rows[1]), L::load(&rows[2])],
+        [L::load(&rows[3]), L::load(&rows[4]), L::load(&rows[5])],
+        [L::load(&rows[6]), L::load(&rows[7]), L::load(&rows[8])],
+    ]
+}
+
 /// A small scene's record that is not a quad, with a sphere around it:
 /// a ray that misses the sphere misses the record, without the record's
 /// own test (a rotated box's transform of the ray costs more).
@@ -300,6 +329,15 @@ impl Geometry {
 
     /// The nearest hit with 0 < t < tmax.
     pub fn intersect(&self, ray: &Ray, tmax: f32) -> Option<Hit> {
+        self.intersect_on(LaneWidth::widest(), ray, tmax)
+    }
+
+    /// [`Geometry::intersect`] with the tree's box and triangle tests on
+    /// the given lanes, which the processor must have
+    /// ([`LaneWidth::available`]; panics if not): for tests. One ray goes
+    /// at most eight lanes wide (`Sixteen` takes eight).
+    #[doc(hidden)]
+    pub fn intersect_on(&self, lanes: LaneWidth, ray: &Ray, tmax: f32) -> Option<Hit> {
         let mut best = Hit { t: tmax, id: u32::MAX };
         if let Some((quads, others)) = &self.small {
             let (o, d) = (ray.origin, ray.dir);
@@ -318,7 +356,7 @@ impl Geometry {
         } else {
             match &self.bvh {
                 Some(bvh) => {
-                    let found = self.nearest_in_tree(bvh, ray.origin, ray.dir, tmax);
+                    let found = self.nearest_in_tree(lanes, bvh, ray.origin, ray.dir, tmax);
                     if let Some((t, id)) = found {
                         best = Hit { t, id };
                     }
@@ -340,13 +378,23 @@ impl Geometry {
     /// The nearest (t, primitive) in the tree on the segment (0, tmax),
     /// with the box tests eight at a time where the processor has AVX.
     #[inline]
-    fn nearest_in_tree(&self, bvh: &Bvh8, o: Vec3, d: Vec3, tmax: f32) -> Option<(f32, u32)> {
-        #[cfg(target_arch = "x86_64")]
-        if has_avx() {
-            // SAFETY: the processor has AVX.
-            return unsafe { self.nearest_in_tree_avx(bvh, o, d, tmax) };
+    fn nearest_in_tree(&self, lanes: LaneWidth, bvh: &Bvh8, o: Vec3, d: Vec3, tmax: f32) -> Option<(f32, u32)> {
+        match lanes {
+            LaneWidth::Portable => self.nearest_in_tree_with::<Scalar4>(bvh, o, d, tmax, |first, count, best| {
+                self.leaf_nearest::<Scalar4>(first, count, o, d, best)
+            }),
+            LaneWidth::Four => self.nearest_in_tree_with::<NativeLanes>(bvh, o, d, tmax, |first, count, best| {
+                self.leaf_nearest::<NativeLanes>(first, count, o, d, best)
+            }),
+            // SAFETY: the processor has AVX (asserted).
+            #[cfg(target_arch = "x86_64")]
+            LaneWidth::Eight | LaneWidth::Sixteen => {
+                assert!(has_avx(), "this processor has no AVX");
+                unsafe { self.nearest_in_tree_avx(bvh, o, d, tmax) }
+            }
+            #[cfg(not(target_arch = "x86_64"))]
+            LaneWidth::Eight | LaneWidth::Sixteen => unreachable!("never available here"),
         }
-        self.nearest_in_tree_with::<NativeLanes>(bvh, o, d, tmax)
     }
 
     /// [`Geometry::nearest_in_tree`] compiled for AVX.
@@ -356,18 +404,36 @@ impl Geometry {
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx")]
     unsafe fn nearest_in_tree_avx(&self, bvh: &Bvh8, o: Vec3, d: Vec3, tmax: f32) -> Option<(f32, u32)> {
-        self.nearest_in_tree_with::<Avx8>(bvh, o, d, tmax)
+        // A closure is compiled without the function's AVX, so the leaf's
+        // lanes go through a function of its own that has it.
+        #[target_feature(enable = "avx")]
+        unsafe fn leaf(g: &Geometry, first: u32, count: u32, o: Vec3, d: Vec3, best: (f32, u32)) -> Option<(f32, u32)> {
+            g.leaf_nearest::<Avx8>(first, count, o, d, best)
+        }
+        // SAFETY: the processor has AVX (this function's contract).
+        self.nearest_in_tree_with::<Avx8>(bvh, o, d, tmax, |first, count, best| unsafe {
+            leaf(self, first, count, o, d, best)
+        })
     }
 
+    /// The tree's nearest hit with box tests on lanes `B`, leaves of
+    /// triangles alone tested by `triangles(first, count, best)`.
     #[inline(always)]
-    fn nearest_in_tree_with<B: Lanes>(&self, bvh: &Bvh8, o: Vec3, d: Vec3, tmax: f32) -> Option<(f32, u32)> {
+    fn nearest_in_tree_with<B: Lanes>(
+        &self,
+        bvh: &Bvh8,
+        o: Vec3,
+        d: Vec3,
+        tmax: f32,
+        triangles: impl Fn(u32, u32, (f32, u32)) -> Option<(f32, u32)>,
+    ) -> Option<(f32, u32)> {
         let box_ray = BoxRay::new(o.to_array(), d.to_array());
         bvh.closest::<B>(
             &box_ray,
             tmax,
             |first, count, mixed, (mut best_t, mut best_id)| {
                 if !mixed {
-                    return self.leaf_nearest(first, count, o, d, (best_t, best_id));
+                    return triangles(first, count, (best_t, best_id));
                 }
                 let mut found = None;
                 for i in first..first + count {
@@ -403,6 +469,13 @@ impl Geometry {
 
     /// Whether anything lies on the open segment `origin + t·dir`, 0 < t < tmax.
     pub fn occluded(&self, origin: Vec3, dir: Vec3, tmax: f32) -> bool {
+        self.occluded_on(LaneWidth::widest(), origin, dir, tmax)
+    }
+
+    /// [`Geometry::occluded`] with the tree's box tests on the given lanes,
+    /// as [`Geometry::intersect_on`]: for tests.
+    #[doc(hidden)]
+    pub fn occluded_on(&self, lanes: LaneWidth, origin: Vec3, dir: Vec3, tmax: f32) -> bool {
         count_shadow_rays(1);
         if self.occluded_unbounded(origin, dir, tmax) {
             return true;
@@ -415,14 +488,18 @@ impl Geometry {
                 });
         }
         match &self.bvh {
-            Some(bvh) => {
+            Some(bvh) => match lanes {
+                LaneWidth::Portable => self.occluded_bvh::<Scalar4>(bvh, origin, dir, tmax),
+                LaneWidth::Four => self.occluded_bvh::<NativeLanes>(bvh, origin, dir, tmax),
+                // SAFETY: the processor has AVX (asserted).
                 #[cfg(target_arch = "x86_64")]
-                if has_avx() {
-                    // SAFETY: the processor has AVX.
-                    return unsafe { self.occluded_bvh_avx(bvh, origin, dir, tmax) };
+                LaneWidth::Eight | LaneWidth::Sixteen => {
+                    assert!(has_avx(), "this processor has no AVX");
+                    unsafe { self.occluded_bvh_avx(bvh, origin, dir, tmax) }
                 }
-                self.occluded_bvh::<NativeLanes>(bvh, origin, dir, tmax)
-            }
+                #[cfg(not(target_arch = "x86_64"))]
+                LaneWidth::Eight | LaneWidth::Sixteen => unreachable!("never available here"),
+            },
             None => self.occluded_linear(origin, dir, tmax),
         }
     }
@@ -483,36 +560,23 @@ impl Geometry {
 
     /// Of triangles `first .. first + count` (a leaf of triangles only), the
     /// nearest hit that comes before `best` (as [`comes_before`] orders
-    /// them), if any: four triangles at a time in SIMD lanes, each lane
+    /// them), if any: `L::WIDTH` triangles at a time in SIMD lanes, each lane
     /// operation for operation as [`intersect_triangle`](super::intersect_triangle), and the lanes'
     /// hits then taken in index order against the bound the one-triangle
     /// loop would use, so that the answer is that loop's, bit for bit. A
     /// ray across the inside of a 1.1 M-triangle mesh tests about 19
     /// triangles in 4 leaves.
     #[inline(always)]
-    fn leaf_nearest(&self, first: u32, count: u32, o: Vec3, d: Vec3, best: (f32, u32)) -> Option<(f32, u32)> {
-        type L = NativeLanes;
+    fn leaf_nearest<L: Lanes>(&self, first: u32, count: u32, o: Vec3, d: Vec3, best: (f32, u32)) -> Option<(f32, u32)> {
         let (mut best_t, mut best_id) = best;
         let mut found = None;
-        let splat = |v: Vec3| [L::splat(v.x), L::splat(v.y), L::splat(v.z)];
-        let (d4, o4) = (splat(d), splat(o));
+        let (d4, o4) = (splat::<L>(d), splat::<L>(o));
         let end = first + count;
         let mut start = first;
         while start < end {
-            let n = (end - start).min(4) as usize;
-            let group = &self.triangles[start as usize..start as usize + n];
-            // Lanes past the leaf's last triangle hold a degenerate one
-            // (zero edges: no determinant), which never hits.
-            let lanes = |vertex: usize| {
-                [0, 1, 2].map(|axis| {
-                    let mut a = [0.0f32; 4];
-                    for (k, t) in group.iter().enumerate() {
-                        a[k] = t[vertex][axis];
-                    }
-                    L::load(&a)
-                })
-            };
-            let (hits, t) = triangle_hits(triangle_terms(d4, o4, lanes(0), lanes(1), lanes(2)));
+            let n = (end - start).min(L::WIDTH as u32) as usize;
+            let [v0, e1, e2] = gather::<L>(&self.triangles[start as usize..start as usize + n]);
+            let (hits, t) = triangle_hits(triangle_terms(d4, o4, v0, e1, e2));
             let t = t.to_array();
             let mut m = hits & ((1u32 << n) - 1);
             while m != 0 {

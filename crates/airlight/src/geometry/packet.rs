@@ -249,15 +249,24 @@ impl Packet {
 /// by it).
 #[inline(always)]
 pub(super) fn triangle_terms<L: Lanes>(d: [L; 3], o: [L; 3], v0: [L; 3], e1: [L; 3], e2: [L; 3]) -> [L; 4] {
-    let cross = |a: &[L; 3], b: &[L; 3]| {
-        [a[1].mul(b[2]).sub(b[1].mul(a[2])), a[2].mul(b[0]).sub(b[2].mul(a[0])), a[0].mul(b[1]).sub(b[0].mul(a[1]))]
-    };
-    let dot = |a: &[L; 3], b: &[L; 3]| a[0].mul(b[0]).add(a[1].mul(b[1])).add(a[2].mul(b[2]));
     let pvec = cross(&d, &e2);
     let det = dot(&e1, &pvec);
     let tvec = [o[0].sub(v0[0]), o[1].sub(v0[1]), o[2].sub(v0[2])];
     let qvec = cross(&tvec, &e1);
     [det, dot(&tvec, &pvec), dot(&d, &qvec), dot(&e2, &qvec)]
+}
+
+// Functions rather than closures: a closure is compiled without the
+// target features of the function it is written in, and where it is not
+// inlined its AVX lanes become calls.
+#[inline(always)]
+fn cross<L: Lanes>(a: &[L; 3], b: &[L; 3]) -> [L; 3] {
+    [a[1].mul(b[2]).sub(b[1].mul(a[2])), a[2].mul(b[0]).sub(b[2].mul(a[0])), a[0].mul(b[1]).sub(b[0].mul(a[1]))]
+}
+
+#[inline(always)]
+fn dot<L: Lanes>(a: &[L; 3], b: &[L; 3]) -> L {
+    a[0].mul(b[0]).add(a[1].mul(b[1])).add(a[2].mul(b[2]))
 }
 
 /// From [`triangle_terms`], as [`super::intersect_triangle`] decides: the
