@@ -511,23 +511,68 @@ impl Geometry {
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx")]
     unsafe fn occluded_bvh_avx(&self, bvh: &Bvh8, origin: Vec3, dir: Vec3, tmax: f32) -> bool {
-        self.occluded_bvh::<Avx8>(bvh, origin, dir, tmax)
+        #[target_feature(enable = "avx")]
+        unsafe fn leaf(g: &Geometry, first: u32, count: u32, o: Vec3, d: Vec3, tmax: f32) -> bool {
+            g.leaf_blocks::<Avx8>(first, count, o, d, tmax)
+        }
+        // SAFETY: the processor has AVX (this function's contract).
+        self.occluded_bvh_with::<Avx8>(bvh, origin, dir, tmax, |first, count| unsafe {
+            leaf(self, first, count, origin, dir, tmax)
+        })
+    }
+
+    /// Whether a triangle of the leaf blocks the segment, `L::WIDTH` at a
+    /// time, each lane operation for operation as [`triangle_blocks`].
+    #[inline(always)]
+    fn leaf_blocks<L: Lanes>(&self, first: u32, count: u32, o: Vec3, d: Vec3, tmax: f32) -> bool {
+        let (d4, o4) = (splat::<L>(d), splat::<L>(o));
+        let end = first + count;
+        let mut start = first;
+        while start < end {
+            let n = (end - start).min(L::WIDTH as u32) as usize;
+            let [v0, e1, e2] = gather::<L>(&self.triangles[start as usize..start as usize + n]);
+            let [det, u, v, t] = triangle_terms(d4, o4, v0, e1, e2);
+            let abs_det = det.abs();
+            let ok_det = !abs_det.lt(L::splat(1e-20)) & ((1u32 << n) - 1);
+            let (u, v, t) = (u.flip_sign(det), v.flip_sign(det), t.flip_sign(det));
+            let ok_u = L::splat(0.0).le(u) & u.le(abs_det);
+            let miss_v = v.lt(L::splat(0.0)) | abs_det.lt(u.add(v));
+            let ok_t = L::splat(0.0).lt(t) & t.lt(L::splat(tmax).mul(abs_det));
+            if ok_det & ok_u & !miss_v & ok_t != 0 {
+                return true;
+            }
+            start += n as u32;
+        }
+        false
     }
 
     /// Whether a primitive in the tree blocks the segment, with the box
     /// tests `B::WIDTH` at a time.
     #[inline(always)]
     pub(super) fn occluded_bvh<B: Lanes>(&self, bvh: &Bvh8, origin: Vec3, dir: Vec3, tmax: f32) -> bool {
+        self.occluded_bvh_with::<B>(bvh, origin, dir, tmax, |first, count| {
+            (first..first + count).any(|i| {
+                let [v0, e1, e2] = self.triangles[i as usize];
+                triangle_blocks(v0, e1, e2, origin, dir, tmax)
+            })
+        })
+    }
+
+    #[inline(always)]
+    fn occluded_bvh_with<B: Lanes>(
+        &self,
+        bvh: &Bvh8,
+        origin: Vec3,
+        dir: Vec3,
+        tmax: f32,
+        triangles: impl Fn(u32, u32) -> bool,
+    ) -> bool {
         let box_ray = BoxRay::new(origin.to_array(), dir.to_array());
         bvh.any::<B>(&box_ray, tmax, |first, count, mixed| {
-            (first..first + count).any(|i| {
-                if mixed {
-                    self.records[i as usize].prim.intersect(origin, dir, 0.0, tmax) < tmax
-                } else {
-                    let [v0, e1, e2] = self.triangles[i as usize];
-                    triangle_blocks(v0, e1, e2, origin, dir, tmax)
-                }
-            })
+            if !mixed {
+                return triangles(first, count);
+            }
+            (first..first + count).any(|i| self.records[i as usize].prim.intersect(origin, dir, 0.0, tmax) < tmax)
         })
     }
 
