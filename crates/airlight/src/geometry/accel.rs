@@ -640,8 +640,8 @@ impl Geometry {
 
     /// Record `i`'s hit distance in (0, tmax), or infinity, by its own
     /// primitive's test: for leaves that hold something other than
-    /// triangles (leaves of triangles alone go four at a time, from the
-    /// compact copies).
+    /// triangles (leaves of triangles alone go several at a time in lanes,
+    /// from the compact copies).
     #[inline(always)]
     pub(super) fn intersect_one(&self, i: usize, o: Vec3, d: Vec3, tmax: f32) -> f32 {
         self.records[i].prim.intersect(o, d, 0.0, tmax)

@@ -2,8 +2,8 @@
 //! (`bvh.rs`), for camera rays of neighbouring pixels and shadow rays from
 //! them toward one light.
 //!
-//! Each node is fetched once for the whole packet. Its four child boxes are
-//! first tested against the packet as a whole by interval arithmetic (the
+//! Each node is fetched once for the whole packet. Its eight child boxes are
+//! first tested (four at a time) against the packet as a whole by interval arithmetic (the
 //! range of origins and of reciprocal directions, Boulos et al., "Packet-based
 //! Whitted and distribution ray tracing", 2007), which drops children that no
 //! ray of the packet can enter without testing any ray. A child that passes
@@ -177,8 +177,8 @@ impl Packet {
         out
     }
 
-    /// Which of `node`'s four children some ray of the packet may enter
-    /// (bit c for child c), and a lower bound on every ray's entry distance
+    /// Which of the four children `at..at + 4` of `node` some ray of the
+    /// packet may enter (bit c for child at + c), and a lower bound on every ray's entry distance
     /// into each: interval arithmetic over the packet's ranges of origins
     /// and reciprocal directions. Rounding is monotonic, so the bounds hold
     /// the values each ray's own test computes, and no child that a ray
