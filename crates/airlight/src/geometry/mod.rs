@@ -4,6 +4,7 @@ mod accel;
 mod batch;
 mod bvh;
 mod lanes;
+mod one_ray;
 mod packet;
 mod quad_lanes;
 mod ray;
