@@ -51,7 +51,7 @@ impl Geometry {
     /// The processor must have AVX.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx")]
-    pub(super) unsafe fn nearest_in_tree_avx(&self, bvh: &Bvh8, o: Vec3, d: Vec3, tmax: f32) -> Option<(f32, u32)> {
+    unsafe fn nearest_in_tree_avx(&self, bvh: &Bvh8, o: Vec3, d: Vec3, tmax: f32) -> Option<(f32, u32)> {
         // A closure is compiled without the function's AVX, so the leaf's
         // lanes go through a function of its own that has it.
         #[target_feature(enable = "avx")]
@@ -121,7 +121,7 @@ impl Geometry {
     /// The processor must have AVX.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx")]
-    pub(super) unsafe fn occluded_bvh_avx(&self, bvh: &Bvh8, origin: Vec3, dir: Vec3, tmax: f32) -> bool {
+    unsafe fn occluded_bvh_avx(&self, bvh: &Bvh8, origin: Vec3, dir: Vec3, tmax: f32) -> bool {
         #[target_feature(enable = "avx")]
         unsafe fn leaf(g: &Geometry, first: u32, count: u32, o: Vec3, d: Vec3, tmax: f32) -> bool {
             g.leaf_blocks::<Avx8>(first, count, o, d, tmax)
