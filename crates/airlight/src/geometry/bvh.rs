@@ -9,9 +9,10 @@
 //! Why eight children rather than four: a ray descends half as many levels,
 //! and each level is a wait on memory when the tree and triangles exceed
 //! the cache. On a 1.1 M-triangle mesh, one ray at a time, incoherent rays
-//! across its inside ran 1.25× as fast with eight as with four, camera and
-//! shadow rays about 1.2×, and packets of coherent rays the same
-//! (BENCHMARKS.md has the figures). The width is a parameter of the types
+//! across its inside ran 1.32× as fast with eight as with four and out of
+//! it 1.20×, camera and shadow rays 1.27× and 1.29×, and packets of
+//! coherent rays 1.17× and 1.11× (bench_bvh, 6 side-by-side pairs;
+//! BENCHMARKS.md has the figures). The width is a parameter of the types
 //! so that tests can compare trees of both widths.
 //!
 //! Why not obvhs's own traversal of its compressed 8-wide BVH: on a 1.1 M
@@ -136,8 +137,9 @@ struct Entry {
     tnear: f32,
 }
 
-/// The traversal stack, left uninitialised: zeroing its 3 KB per ray would
-/// cost more than the traversal of a coherent ray.
+/// The traversal stack, left uninitialised: zeroing it per ray (2 KB then,
+/// with four children a node; 3 KB now) cost more than the traversal of a
+/// coherent ray.
 struct Stack {
     entries: [std::mem::MaybeUninit<Entry>; STACK_SIZE],
     top: usize,
@@ -370,6 +372,7 @@ fn set_child<const W: usize>(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::geometry::batch::comes_before;
     use crate::geometry::lanes::{NativeLanes, Scalar4};
     use crate::geometry::shape::intersect_triangle;
     use glam::{Vec3, Vec3A};
@@ -434,7 +437,7 @@ mod tests {
             for i in first..first + count {
                 let [v0, v1, v2] = triangles[i as usize];
                 let t = intersect_triangle(v0, v1 - v0, v2 - v0, o, d, 0.0, f32::INFINITY);
-                if t < f32::INFINITY && (t < best_t || (t == best_t && i < best_id)) {
+                if comes_before(t, i, best_t, best_id) {
                     (best_t, best_id) = (t, i);
                     found = Some((t, i));
                 }

@@ -11,7 +11,7 @@ use super::bvh::{BoxRay, Bvh8};
 #[cfg(target_arch = "x86_64")]
 use super::lanes::{Avx8, has_avx};
 use super::lanes::{LaneWidth, Lanes, NativeLanes, Scalar4};
-use super::packet::{triangle_hits, triangle_terms};
+use super::packet::{triangle_blocks_mask, triangle_hits, triangle_terms};
 use super::shape::triangle_blocks;
 use glam::Vec3;
 
@@ -142,14 +142,8 @@ impl Geometry {
         while start < end {
             let n = (end - start).min(L::WIDTH as u32) as usize;
             let [v0, e1, e2] = gather::<L>(&self.triangles[start as usize..start as usize + n]);
-            let [det, u, v, t] = triangle_terms(d4, o4, v0, e1, e2);
-            let abs_det = det.abs();
-            let ok_det = !abs_det.lt(L::splat(1e-20)) & ((1u32 << n) - 1);
-            let (u, v, t) = (u.flip_sign(det), v.flip_sign(det), t.flip_sign(det));
-            let ok_u = L::splat(0.0).le(u) & u.le(abs_det);
-            let miss_v = v.lt(L::splat(0.0)) | abs_det.lt(u.add(v));
-            let ok_t = L::splat(0.0).lt(t) & t.lt(L::splat(tmax).mul(abs_det));
-            if ok_det & ok_u & !miss_v & ok_t != 0 {
+            let blocked = triangle_blocks_mask(triangle_terms(d4, o4, v0, e1, e2), L::splat(tmax));
+            if blocked & ((1u32 << n) - 1) != 0 {
                 return true;
             }
             start += n as u32;

@@ -2,11 +2,12 @@
 //! (`bvh.rs`), for camera rays of neighbouring pixels and shadow rays from
 //! them toward one light.
 //!
-//! Each node is fetched once for the whole packet. Its eight child boxes are
-//! first tested (four at a time) against the packet as a whole by interval arithmetic (the
-//! range of origins and of reciprocal directions, Boulos et al., "Packet-based
-//! Whitted and distribution ray tracing", 2007), which drops children that no
-//! ray of the packet can enter without testing any ray. A child that passes
+//! Each node is fetched once for the whole packet. Its eight child boxes
+//! are first tested, four at a time, against the packet as a whole by
+//! interval arithmetic (the range of origins and of reciprocal directions,
+//! Boulos et al., "Packet-based Whitted and distribution ray tracing",
+//! 2007), which drops children that no ray of the packet can enter without
+//! testing any ray. A child that passes
 //! is then tested ray by ray, a group of rays at a time (four, eight or
 //! sixteen, the width of the [`Lanes`]), when it is visited (so that the
 //! rays' nearest hits found meanwhile cull it), and only the rays that
@@ -178,9 +179,9 @@ impl Packet {
     }
 
     /// Which of the four children `at..at + 4` of `node` some ray of the
-    /// packet may enter (bit c for child at + c), and a lower bound on every ray's entry distance
-    /// into each: interval arithmetic over the packet's ranges of origins
-    /// and reciprocal directions. Rounding is monotonic, so the bounds hold
+    /// packet may enter (bit c for child at + c), and a lower bound on
+    /// every ray's entry distance into each: interval arithmetic over the
+    /// packet's ranges of origins and reciprocal directions. Rounding is monotonic, so the bounds hold
     /// the values each ray's own test computes, and no child that a ray
     /// enters is dropped.
     #[inline(always)]
@@ -231,14 +232,7 @@ impl Packet {
     /// division).
     #[inline(always)]
     pub fn triangle_blocks_lanes<L: Lanes>(&self, s: usize, triangle: &[Vec3; 3]) -> u32 {
-        let [det, u, v, t] = self.triangle_terms::<L>(s, triangle);
-        let abs_det = det.abs();
-        let ok_det = !abs_det.lt(L::splat(1e-20)) & lane_mask::<L>() as u32;
-        let (u, v, t) = (u.flip_sign(det), v.flip_sign(det), t.flip_sign(det));
-        let ok_u = L::splat(0.0).le(u) & u.le(abs_det);
-        let miss_v = v.lt(L::splat(0.0)) | abs_det.lt(u.add(v));
-        let ok_t = L::splat(0.0).lt(t) & t.lt(L::load(&self.tmax[s..]).mul(abs_det));
-        ok_det & ok_u & !miss_v & ok_t
+        triangle_blocks_mask(self.triangle_terms::<L>(s, triangle), L::load(&self.tmax[s..]))
     }
 }
 
@@ -267,6 +261,19 @@ fn cross<L: Lanes>(a: &[L; 3], b: &[L; 3]) -> [L; 3] {
 #[inline(always)]
 fn dot<L: Lanes>(a: &[L; 3], b: &[L; 3]) -> L {
     a[0].mul(b[0]).add(a[1].mul(b[1])).add(a[2].mul(b[2]))
+}
+
+/// From [`triangle_terms`], as [`super::triangle_blocks`] decides (no
+/// division): the mask of lanes whose triangle blocks the segment (0, tmax).
+#[inline(always)]
+pub(super) fn triangle_blocks_mask<L: Lanes>([det, u, v, t]: [L; 4], tmax: L) -> u32 {
+    let abs_det = det.abs();
+    let ok_det = !abs_det.lt(L::splat(1e-20)) & lane_mask::<L>() as u32;
+    let (u, v, t) = (u.flip_sign(det), v.flip_sign(det), t.flip_sign(det));
+    let ok_u = L::splat(0.0).le(u) & u.le(abs_det);
+    let miss_v = v.lt(L::splat(0.0)) | abs_det.lt(u.add(v));
+    let ok_t = L::splat(0.0).lt(t) & t.lt(tmax.mul(abs_det));
+    ok_det & ok_u & !miss_v & ok_t
 }
 
 /// From [`triangle_terms`], as [`super::intersect_triangle`] decides: the
