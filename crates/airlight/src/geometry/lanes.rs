@@ -37,6 +37,26 @@ pub trait Lanes: Copy {
     fn le(self, o: Self) -> u32;
     fn eq(self, o: Self) -> u32;
 
+    /// Triangles' stored (v0, e1, e2) in lanes, lane k from `group[k]`, and
+    /// the lanes past the group's end repeating its last triangle (whose
+    /// answers the caller drops): 1 to `WIDTH` triangles. The vector types
+    /// transpose in registers; filling an array and loading it as vectors
+    /// waited on store forwarding (a tenth of a ray's time across the
+    /// inside of a mesh).
+    #[inline(always)]
+    fn triangles(group: &[[glam::Vec3; 3]]) -> [[Self; 3]; 3] {
+        let mut rows = [[0.0f32; 16]; 9];
+        for k in 0..Self::WIDTH {
+            let triangle = &group[k.min(group.len() - 1)];
+            for (v, vector) in triangle.iter().enumerate() {
+                rows[3 * v][k] = vector.x;
+                rows[3 * v + 1][k] = vector.y;
+                rows[3 * v + 2][k] = vector.z;
+            }
+        }
+        std::array::from_fn(|v| std::array::from_fn(|a| Self::load(&rows[3 * v + a])))
+    }
+
     /// Writes lane i to `out[i]` where bit i of `mask` is set, leaving the
     /// rest of `out[..WIDTH]` as it is.
     #[inline(always)]
@@ -148,6 +168,79 @@ mod x86 {
     use super::Lanes;
     use std::arch::x86_64::*;
 
+    /// Where triangle k of the group (its last for k past the end) starts:
+    /// nine f32s, the x, y, z of v0, e1 and e2. Loads of four at 0, 4 and 5
+    /// stay within them.
+    #[inline(always)]
+    fn triangle_floats(group: &[[glam::Vec3; 3]], k: usize) -> *const f32 {
+        const { assert!(std::mem::size_of::<[glam::Vec3; 3]>() == 36) };
+        group[k.min(group.len() - 1)].as_ptr().cast::<f32>()
+    }
+
+    /// Four floats from `at` of each triangle.
+    #[inline(always)]
+    unsafe fn rows4(t: &[*const f32; 4], at: usize) -> [__m128; 4] {
+        unsafe {
+            [
+                _mm_loadu_ps(t[0].add(at)),
+                _mm_loadu_ps(t[1].add(at)),
+                _mm_loadu_ps(t[2].add(at)),
+                _mm_loadu_ps(t[3].add(at)),
+            ]
+        }
+    }
+
+    /// The 4×4 transpose: lane k of output j is lane j of input k.
+    #[inline(always)]
+    unsafe fn transpose4([r0, r1, r2, r3]: [__m128; 4]) -> [__m128; 4] {
+        unsafe {
+            let (t0, t1) = (_mm_unpacklo_ps(r0, r1), _mm_unpacklo_ps(r2, r3));
+            let (t2, t3) = (_mm_unpackhi_ps(r0, r1), _mm_unpackhi_ps(r2, r3));
+            [_mm_movelh_ps(t0, t1), _mm_movehl_ps(t1, t0), _mm_movelh_ps(t2, t3), _mm_movehl_ps(t3, t2)]
+        }
+    }
+
+    /// Lane 3 of each input, in order.
+    #[inline(always)]
+    unsafe fn fourth4([r0, r1, r2, r3]: [__m128; 4]) -> __m128 {
+        unsafe { _mm_movehl_ps(_mm_unpackhi_ps(r2, r3), _mm_unpackhi_ps(r0, r1)) }
+    }
+
+    /// Four floats from `at` of triangles k (low half) and k + 4 (high
+    /// half), for k = 0..4.
+    #[inline(always)]
+    unsafe fn rows8(t: &[*const f32; 8], at: usize) -> [__m256; 4] {
+        unsafe {
+            [
+                _mm256_loadu2_m128(t[4].add(at), t[0].add(at)),
+                _mm256_loadu2_m128(t[5].add(at), t[1].add(at)),
+                _mm256_loadu2_m128(t[6].add(at), t[2].add(at)),
+                _mm256_loadu2_m128(t[7].add(at), t[3].add(at)),
+            ]
+        }
+    }
+
+    /// [`transpose4`] in each 128-bit half.
+    #[inline(always)]
+    unsafe fn transpose8([r0, r1, r2, r3]: [__m256; 4]) -> [__m256; 4] {
+        unsafe {
+            let (t0, t1) = (_mm256_unpacklo_ps(r0, r1), _mm256_unpacklo_ps(r2, r3));
+            let (t2, t3) = (_mm256_unpackhi_ps(r0, r1), _mm256_unpackhi_ps(r2, r3));
+            [
+                _mm256_shuffle_ps::<0b01_00_01_00>(t0, t1),
+                _mm256_shuffle_ps::<0b11_10_11_10>(t0, t1),
+                _mm256_shuffle_ps::<0b01_00_01_00>(t2, t3),
+                _mm256_shuffle_ps::<0b11_10_11_10>(t2, t3),
+            ]
+        }
+    }
+
+    /// [`fourth4`] in each 128-bit half.
+    #[inline(always)]
+    unsafe fn fourth8([r0, r1, r2, r3]: [__m256; 4]) -> __m256 {
+        unsafe { _mm256_shuffle_ps::<0b11_10_11_10>(_mm256_unpackhi_ps(r0, r1), _mm256_unpackhi_ps(r2, r3)) }
+    }
+
     /// Four lanes in an SSE register.
     #[derive(Clone, Copy, Debug)]
     pub struct Sse4(__m128);
@@ -159,6 +252,27 @@ mod x86 {
         const WIDTH: usize = 4;
         type Four = Sse4;
         type Array = [f32; 4];
+        #[inline(always)]
+        fn triangles(group: &[[glam::Vec3; 3]]) -> [[Self; 3]; 3] {
+            let t = [
+                triangle_floats(group, 0),
+                triangle_floats(group, 1),
+                triangle_floats(group, 2),
+                triangle_floats(group, 3),
+            ];
+            // SAFETY: SSE is part of the x86-64 baseline; each load reads
+            // four of a triangle's nine floats (`triangle_floats`).
+            unsafe {
+                let [v0x, v0y, v0z, e1x] = transpose4(rows4(&t, 0));
+                let [e1y, e1z, e2x, e2y] = transpose4(rows4(&t, 4));
+                let e2z = fourth4(rows4(&t, 5));
+                [
+                    [Sse4(v0x), Sse4(v0y), Sse4(v0z)],
+                    [Sse4(e1x), Sse4(e1y), Sse4(e1z)],
+                    [Sse4(e2x), Sse4(e2y), Sse4(e2z)],
+                ]
+            }
+        }
         #[inline(always)]
         fn splat(x: f32) -> Self {
             unsafe { Sse4(_mm_set1_ps(x)) }
@@ -242,6 +356,33 @@ mod x86 {
         const WIDTH: usize = 8;
         type Four = Sse4;
         type Array = [f32; 8];
+        #[inline(always)]
+        fn triangles(group: &[[glam::Vec3; 3]]) -> [[Self; 3]; 3] {
+            // No closures here: a closure is compiled without the AVX of the
+            // function it is inlined into.
+            let t = [
+                triangle_floats(group, 0),
+                triangle_floats(group, 1),
+                triangle_floats(group, 2),
+                triangle_floats(group, 3),
+                triangle_floats(group, 4),
+                triangle_floats(group, 5),
+                triangle_floats(group, 6),
+                triangle_floats(group, 7),
+            ];
+            // SAFETY: as for every `Avx8` function; each load reads four of a
+            // triangle's nine floats (`triangle_floats`).
+            unsafe {
+                let [v0x, v0y, v0z, e1x] = transpose8(rows8(&t, 0));
+                let [e1y, e1z, e2x, e2y] = transpose8(rows8(&t, 4));
+                let e2z = fourth8(rows8(&t, 5));
+                [
+                    [Avx8(v0x), Avx8(v0y), Avx8(v0z)],
+                    [Avx8(e1x), Avx8(e1y), Avx8(e1z)],
+                    [Avx8(e2x), Avx8(e2y), Avx8(e2z)],
+                ]
+            }
+        }
         #[inline(always)]
         fn splat(x: f32) -> Self {
             unsafe { Avx8(_mm256_set1_ps(x)) }
@@ -503,6 +644,30 @@ mod tests {
                         "store, lane {k}, mask {mask:b}"
                     );
                     assert_eq!(ids[k], if on { 3 } else { 9 }, "fill, lane {k}, mask {mask:b}");
+                }
+            }
+        }
+        // Triangles into lanes: every float moved bit for bit, lanes past a
+        // group's end repeating its last triangle, for every group size.
+        let float = |k: usize, v: usize, a: usize| match (k + v + a) % 5 {
+            0 => VALUES[(k + 3 * v + a) % 8],
+            _ => (100 * k + 10 * v + a) as f32 + 0.25,
+        };
+        let all: Vec<[glam::Vec3; 3]> = (0..L::WIDTH)
+            .map(|k| std::array::from_fn(|v| glam::Vec3::new(float(k, v, 0), float(k, v, 1), float(k, v, 2))))
+            .collect();
+        for len in 1..=L::WIDTH {
+            let lanes = L::triangles(&all[..len]);
+            for (v, vector) in lanes.iter().enumerate() {
+                for (a, axis) in vector.iter().enumerate() {
+                    for k in 0..L::WIDTH {
+                        let want = float(k.min(len - 1), v, a);
+                        assert_eq!(
+                            axis.to_array()[k].to_bits(),
+                            want.to_bits(),
+                            "{len} triangles: lane {k}, vector {v}, axis {a}"
+                        );
+                    }
                 }
             }
         }

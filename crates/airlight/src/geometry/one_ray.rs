@@ -141,7 +141,7 @@ impl Geometry {
         let mut start = first;
         while start < end {
             let n = (end - start).min(L::WIDTH as u32) as usize;
-            let [v0, e1, e2] = gather::<L>(&self.triangles[start as usize..start as usize + n]);
+            let [v0, e1, e2] = L::triangles(&self.triangles[start as usize..start as usize + n]);
             let blocked = triangle_blocks_mask(triangle_terms(d4, o4, v0, e1, e2), L::splat(tmax));
             if blocked & ((1u32 << n) - 1) != 0 {
                 return true;
@@ -198,7 +198,7 @@ impl Geometry {
         let mut start = first;
         while start < end {
             let n = (end - start).min(L::WIDTH as u32) as usize;
-            let [v0, e1, e2] = gather::<L>(&self.triangles[start as usize..start as usize + n]);
+            let [v0, e1, e2] = L::triangles(&self.triangles[start as usize..start as usize + n]);
             let (hits, t) = triangle_hits(triangle_terms(d4, o4, v0, e1, e2));
             let t = t.to_array();
             let mut m = hits & ((1u32 << n) - 1);
@@ -224,24 +224,4 @@ impl Geometry {
 #[inline(always)]
 fn splat<L: Lanes>(v: Vec3) -> [L; 3] {
     [L::splat(v.x), L::splat(v.y), L::splat(v.z)]
-}
-
-/// Triangles' stored (v0, e1, e2) in lanes, lane k from `group[k]`. Lanes
-/// past the group's last triangle hold a degenerate one (zero edges: no
-/// determinant), which never hits.
-#[inline(always)]
-fn gather<L: Lanes>(group: &[[Vec3; 3]]) -> [[L; 3]; 3] {
-    let mut rows = [[0.0f32; 16]; 9];
-    for (k, triangle) in group.iter().enumerate() {
-        for (v, vector) in triangle.iter().enumerate() {
-            rows[3 * v][k] = vector.x;
-            rows[3 * v + 1][k] = vector.y;
-            rows[3 * v + 2][k] = vector.z;
-        }
-    }
-    [
-        [L::load(&rows[0]), L::load(&rows[1]), L::load(&rows[2])],
-        [L::load(&rows[3]), L::load(&rows[4]), L::load(&rows[5])],
-        [L::load(&rows[6]), L::load(&rows[7]), L::load(&rows[8])],
-    ]
 }
