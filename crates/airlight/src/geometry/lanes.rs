@@ -41,7 +41,7 @@ pub trait Lanes: Copy {
     /// the lanes past the group's end repeating its last triangle (whose
     /// answers the caller drops): 1 to `WIDTH` triangles. SSE and AVX lanes
     /// transpose in registers: filling an array, as here, and loading it as
-    /// vectors waits on store forwarding, and one ray's leaf tests ran
+    /// vectors waits on store forwarding, and one-ray queries ran
     /// 1.09–1.35× as fast without it on a 1.1 M-triangle mesh
     /// (BENCHMARKS.md).
     #[inline(always)]
@@ -274,8 +274,12 @@ mod tests {
                 }
             }
         }
-        // Triangles into lanes: every float moved bit for bit, lanes past a
-        // group's end repeating its last triangle, for every group size.
+        triangles_in_lanes::<L>();
+    }
+
+    /// Triangles into lanes: every float moved bit for bit, lanes past a
+    /// group's end repeating its last triangle, for every group size.
+    fn triangles_in_lanes<L: Lanes>() {
         let float = |k: usize, v: usize, a: usize| match (k + v + a) % 5 {
             0 => VALUES[(k + 3 * v + a) % 8],
             _ => (100 * k + 10 * v + a) as f32 + 0.25,
@@ -298,6 +302,11 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn portable_lanes_take_triangles_as_they_are_stored() {
+        triangles_in_lanes::<Scalar4>();
     }
 
     #[test]

@@ -1,7 +1,8 @@
 //! One ray through the BVH: its nearest hit and whether anything blocks
 //! it, with the box tests and a leaf's triangles in SIMD lanes (eight at a
-//! time where the processor has AVX, found at run time; four with SSE; a
-//! portable loop for tests). Every lane type does the same IEEE operations
+//! time where the processor has AVX, found at run time; without it, boxes
+//! and nearest hits four at a time with SSE and shadow rays' triangles one
+//! by one; a portable loop for tests). Every lane type does the same IEEE operations
 //! as the one-triangle functions, so the answers do not depend on the
 //! processor.
 
