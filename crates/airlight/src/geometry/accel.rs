@@ -6,6 +6,7 @@
 
 use super::Ray;
 use super::batch::{comes_before, test_bound};
+use super::box_lanes::BoxLanes;
 use super::bvh::Bvh8;
 use super::lanes::LaneWidth;
 use super::quad_lanes::QuadLanes;
@@ -14,7 +15,7 @@ use super::records::{
 };
 use super::sdf::sphere_trace;
 use super::shape::Shape;
-use glam::{Mat3, Vec2, Vec3, Vec3A};
+use glam::{Affine3A, Mat3, Vec2, Vec3, Vec3A};
 use obvhs::{BvhBuildParams, aabb::Aabb};
 use std::time::Duration;
 
@@ -76,10 +77,9 @@ pub struct Geometry {
     pub(super) triangles: Vec<[Vec3; 3]>,
     /// None when there are few primitives: testing them all is faster.
     bvh: Option<Bvh8>,
-    /// A small scene of quads and a few other primitives: the quads in
-    /// SIMD lanes and the other records' indices, tested all at once for
-    /// single rays instead of through `bvh` (which packets still use).
-    small: Option<(QuadLanes, Vec<Other>)>,
+    /// A small scene of quads and a few other primitives, tested all at
+    /// once for single rays instead of through `bvh` (which packets still use).
+    small: Option<Small>,
     bounds: Option<(Vec3, Vec3)>,
     /// The texture coordinates of the triangles that have them.
     triangle_uvs: Vec<[Vec2; 3]>,
@@ -92,9 +92,10 @@ pub struct Geometry {
 /// ([`SMALL_LIMIT`]) or the tree.
 const LINEAR_LIMIT: usize = 4;
 /// Up to this many primitives, at least half of them quads and none a
-/// signed distance field, single rays test the quads in SIMD lanes and the
-/// rest one by one rather than through the BVH (quad_lanes.rs): the Cornell box
-/// (six quads, two rotated boxes) renders faster so, with the same hits.
+/// signed distance field, single rays test the quads and boxes in SIMD lanes
+/// and the rest one by one rather than through the BVH (quad_lanes.rs,
+/// box_lanes.rs): the Cornell box (six quads, two rotated boxes) renders
+/// faster so, with the same hits.
 const SMALL_LIMIT: usize = 16;
 /// Up to this many primitives, the BVH's leaves hold one primitive each.
 const SMALL_SCENE: usize = 64;
@@ -216,9 +217,18 @@ impl GeometryBuilder {
     }
 }
 
-/// A small scene's record that is not a quad, with a sphere around it:
-/// a ray that misses the sphere misses the record, without the record's
-/// own test (a rotated box's transform of the ray costs more).
+/// A small scene's primitives for single rays: quads and boxes (turned
+/// or not) in SIMD lanes, and the other records one by one.
+#[derive(Clone, Debug)]
+struct Small {
+    quads: QuadLanes,
+    boxes: BoxLanes,
+    others: Vec<Other>,
+}
+
+/// A small scene's record that is neither a quad nor a box, with a sphere
+/// around it: a ray that misses the sphere misses the record, without the
+/// record's own test (a turned sphere's transform of the ray costs more).
 #[derive(Clone, Copy, Debug)]
 struct Other {
     index: u32,
@@ -239,9 +249,22 @@ impl Other {
     }
 }
 
-/// The quads in lanes and the other records, for a scene small enough
-/// ([`SMALL_LIMIT`]).
-fn small_scene(records: &[Record]) -> Option<(QuadLanes, Vec<Other>)> {
+/// A box record as the box lanes take it: local_from_world if turned, and
+/// its bounds in its own space.
+fn as_box(prim: &Prim) -> Option<(Option<Affine3A>, Vec3, Vec3)> {
+    match prim {
+        Prim::Box { min, max } => Some((None, *min, *max)),
+        Prim::Instance(inst) => match inst.prim {
+            Prim::Box { min, max } => Some((Some(inst.local_from_world), min, max)),
+            _ => None,
+        },
+        _ => None,
+    }
+}
+
+/// The quads and boxes in lanes and the other records, for a scene small
+/// enough ([`SMALL_LIMIT`]).
+fn small_scene(records: &[Record]) -> Option<Small> {
     // Decided before anything is collected: a mesh's million records
     // would otherwise each get a bounding sphere only to be dropped.
     let is_quad = |r: &Record| matches!(r.prim, Prim::Quad { .. });
@@ -259,8 +282,13 @@ fn small_scene(records: &[Record]) -> Option<(QuadLanes, Vec<Other>)> {
             _ => None,
         })
         .collect();
+    let boxes: Vec<(u32, Option<Affine3A>, Vec3, Vec3)> = records
+        .iter()
+        .enumerate()
+        .filter_map(|(i, r)| as_box(&r.prim).map(|(turn, min, max)| (i as u32, turn, min, max)))
+        .collect();
     let others: Vec<Other> = (0..records.len() as u32)
-        .filter(|&i| !is_quad(&records[i as usize]))
+        .filter(|&i| !is_quad(&records[i as usize]) && as_box(&records[i as usize].prim).is_none())
         .map(|index| {
             let b = records[index as usize].prim.bounds();
             let (min, max) = (Vec3::from(b.min), Vec3::from(b.max));
@@ -270,7 +298,7 @@ fn small_scene(records: &[Record]) -> Option<(QuadLanes, Vec<Other>)> {
             Other { index, center: 0.5 * (min + max), radius_squared: radius * radius }
         })
         .collect();
-    Some((QuadLanes::new(&quads), others))
+    Some(Small { quads: QuadLanes::new(&quads), boxes: BoxLanes::new(&boxes), others })
 }
 
 /// The (v0, e1, e2) of every triangle record, zeros for other primitives.
@@ -308,14 +336,16 @@ impl Geometry {
     #[doc(hidden)]
     pub fn intersect_on(&self, lanes: LaneWidth, ray: &Ray, tmax: f32) -> Option<Hit> {
         let mut best = Hit { t: tmax, id: u32::MAX };
-        if let Some((quads, others)) = &self.small {
+        if let Some(small) = &self.small {
             let (o, d) = (ray.origin, ray.dir);
-            quads.for_each_nearest(o, d, tmax, |t, id| {
+            let mut keep = |t, id| {
                 if comes_before(t, id, best.t, best.id) {
                     best = Hit { t, id };
                 }
-            });
-            for other in others.iter().filter(|other| other.may_hit(o, d)) {
+            };
+            small.quads.for_each_nearest(o, d, tmax, &mut keep);
+            small.boxes.for_each_hit(o, d, tmax, &mut keep);
+            for other in small.others.iter().filter(|other| other.may_hit(o, d)) {
                 let i = other.index;
                 let t = self.records[i as usize].prim.intersect(o, d, 0.0, test_bound(best.t, best.id));
                 if comes_before(t, i, best.t, best.id) {
@@ -375,9 +405,10 @@ impl Geometry {
         if self.occluded_unbounded(origin, dir, tmax) {
             return true;
         }
-        if let Some((quads, others)) = &self.small {
-            return quads.any_hit(origin, dir, tmax)
-                || others.iter().any(|other| {
+        if let Some(small) = &self.small {
+            return small.quads.any_hit(origin, dir, tmax)
+                || small.boxes.any_hit(origin, dir, tmax)
+                || small.others.iter().any(|other| {
                     other.may_hit(origin, dir)
                         && self.records[other.index as usize].prim.intersect(origin, dir, 0.0, tmax) < tmax
                 });

@@ -2,6 +2,7 @@
 
 mod accel;
 mod batch;
+mod box_lanes;
 mod bvh;
 mod lanes;
 mod one_ray;
