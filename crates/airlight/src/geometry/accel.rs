@@ -5,17 +5,15 @@
 //! `one_ray.rs`, packets' in `batch.rs` and `packet.rs`.
 
 use super::Ray;
-use super::batch::{comes_before, test_bound};
-use super::box_lanes::BoxLanes;
 use super::bvh::Bvh8;
 use super::lanes::LaneWidth;
-use super::quad_lanes::QuadLanes;
 use super::records::{
     Instance, NO_UV, PlaneRecord, Prim, Record, SdfPrim, UNBOUNDED_FAR, UnboundedSdf, barycentric, intersect_plane,
 };
 use super::sdf::sphere_trace;
 use super::shape::Shape;
-use glam::{Affine3A, Mat3, Vec2, Vec3, Vec3A};
+use super::small::{Small, small_scene};
+use glam::{Mat3, Vec2, Vec3, Vec3A};
 use obvhs::{BvhBuildParams, aabb::Aabb};
 use std::time::Duration;
 
@@ -89,14 +87,8 @@ pub struct Geometry {
 /// fog comparison scenes (3 and 4 primitives, one a sphere enclosing the
 /// rest, whose box no ray misses) render 8% and 4% faster so than through
 /// the tree, with the same hits. Larger scenes take the quads' lanes
-/// ([`SMALL_LIMIT`]) or the tree.
+/// ([`small::SMALL_LIMIT`](super::small::SMALL_LIMIT)) or the tree.
 const LINEAR_LIMIT: usize = 4;
-/// Up to this many primitives, at least half of them quads and none a
-/// signed distance field, single rays test the quads and boxes in SIMD lanes
-/// and the rest one by one rather than through the BVH (quad_lanes.rs,
-/// box_lanes.rs): the Cornell box (six quads, two rotated boxes) renders
-/// faster so, with the same hits.
-const SMALL_LIMIT: usize = 16;
 /// Up to this many primitives, the BVH's leaves hold one primitive each.
 const SMALL_SCENE: usize = 64;
 
@@ -217,90 +209,6 @@ impl GeometryBuilder {
     }
 }
 
-/// A small scene's primitives for single rays: quads and boxes (turned
-/// or not) in SIMD lanes, and the other records one by one.
-#[derive(Clone, Debug)]
-struct Small {
-    quads: QuadLanes,
-    boxes: BoxLanes,
-    others: Vec<Other>,
-}
-
-/// A small scene's record that is neither a quad nor a box, with a sphere
-/// around it: a ray that misses the sphere misses the record, without the
-/// record's own test (a turned sphere's transform of the ray costs more).
-#[derive(Clone, Copy, Debug)]
-struct Other {
-    index: u32,
-    center: Vec3,
-    radius_squared: f32,
-}
-
-impl Other {
-    /// Whether the ray `o + t·d`, t > 0, may meet the record: it passes
-    /// within the sphere, and the sphere is not wholly behind its origin.
-    #[inline]
-    fn may_hit(&self, o: Vec3, d: Vec3) -> bool {
-        let oc = self.center - o;
-        let b = oc.dot(d);
-        let oc2 = oc.length_squared();
-        let inside = oc2 <= self.radius_squared;
-        inside || (b > 0.0 && oc2 * d.length_squared() - b * b <= self.radius_squared * d.length_squared())
-    }
-}
-
-/// A box record as the box lanes take it: local_from_world if turned, and
-/// its bounds in its own space.
-fn as_box(prim: &Prim) -> Option<(Option<Affine3A>, Vec3, Vec3)> {
-    match prim {
-        Prim::Box { min, max } => Some((None, *min, *max)),
-        Prim::Instance(inst) => match inst.prim {
-            Prim::Box { min, max } => Some((Some(inst.local_from_world), min, max)),
-            _ => None,
-        },
-        _ => None,
-    }
-}
-
-/// The quads and boxes in lanes and the other records, for a scene small
-/// enough ([`SMALL_LIMIT`]).
-fn small_scene(records: &[Record]) -> Option<Small> {
-    // Decided before anything is collected: a mesh's million records
-    // would otherwise each get a bounding sphere only to be dropped.
-    let is_quad = |r: &Record| matches!(r.prim, Prim::Quad { .. });
-    let fits = records.len() <= SMALL_LIMIT
-        && 2 * records.iter().filter(|r| is_quad(r)).count() >= records.len()
-        && !records.iter().any(|r| matches!(r.prim, Prim::Sdf(_)));
-    if !fits {
-        return None;
-    }
-    let quads: Vec<(u32, Vec3, Vec3, Vec3)> = records
-        .iter()
-        .enumerate()
-        .filter_map(|(i, r)| match r.prim {
-            Prim::Quad { corner, edge_u, edge_v } => Some((i as u32, corner, edge_u, edge_v)),
-            _ => None,
-        })
-        .collect();
-    let boxes: Vec<(u32, Option<Affine3A>, Vec3, Vec3)> = records
-        .iter()
-        .enumerate()
-        .filter_map(|(i, r)| as_box(&r.prim).map(|(turn, min, max)| (i as u32, turn, min, max)))
-        .collect();
-    let others: Vec<Other> = (0..records.len() as u32)
-        .filter(|&i| !is_quad(&records[i as usize]) && as_box(&records[i as usize].prim).is_none())
-        .map(|index| {
-            let b = records[index as usize].prim.bounds();
-            let (min, max) = (Vec3::from(b.min), Vec3::from(b.max));
-            // Generous: a sphere that only just holds the box could lose a
-            // grazing hit to rounding.
-            let radius = 0.5 * (max - min).length() * 1.001 + 1e-4 * (1.0 + min.abs().max(max.abs()).max_element());
-            Other { index, center: 0.5 * (min + max), radius_squared: radius * radius }
-        })
-        .collect();
-    Some(Small { quads: QuadLanes::new(&quads), boxes: BoxLanes::new(&boxes), others })
-}
-
 /// The (v0, e1, e2) of every triangle record, zeros for other primitives.
 fn triangles_of(records: &[Record]) -> Vec<[Vec3; 3]> {
     records
@@ -337,21 +245,7 @@ impl Geometry {
     pub fn intersect_on(&self, lanes: LaneWidth, ray: &Ray, tmax: f32) -> Option<Hit> {
         let mut best = Hit { t: tmax, id: u32::MAX };
         if let Some(small) = &self.small {
-            let (o, d) = (ray.origin, ray.dir);
-            let mut keep = |t, id| {
-                if comes_before(t, id, best.t, best.id) {
-                    best = Hit { t, id };
-                }
-            };
-            small.quads.for_each_nearest(o, d, tmax, &mut keep);
-            small.boxes.for_each_hit(o, d, tmax, &mut keep);
-            for other in small.others.iter().filter(|other| other.may_hit(o, d)) {
-                let i = other.index;
-                let t = self.records[i as usize].prim.intersect(o, d, 0.0, test_bound(best.t, best.id));
-                if comes_before(t, i, best.t, best.id) {
-                    best = Hit { t, id: i };
-                }
-            }
+            small.nearest(&self.records, ray.origin, ray.dir, tmax, &mut best);
         } else {
             match &self.bvh {
                 Some(bvh) => {
@@ -406,12 +300,7 @@ impl Geometry {
             return true;
         }
         if let Some(small) = &self.small {
-            return small.quads.any_hit(origin, dir, tmax)
-                || small.boxes.any_hit(origin, dir, tmax)
-                || small.others.iter().any(|other| {
-                    other.may_hit(origin, dir)
-                        && self.records[other.index as usize].prim.intersect(origin, dir, 0.0, tmax) < tmax
-                });
+            return small.any(&self.records, origin, dir, tmax);
         }
         match &self.bvh {
             Some(bvh) => self.blocked_in_tree(lanes, bvh, origin, dir, tmax),

@@ -12,6 +12,7 @@ mod ray;
 mod records;
 pub mod sdf;
 mod shape;
+mod small;
 
 pub use accel::{Geometry, GeometryBuilder, Hit, SurfaceHit, shadow_rays_traced};
 pub use batch::Segment;
