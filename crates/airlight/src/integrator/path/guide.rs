@@ -14,7 +14,7 @@
 //! ([`crate::sampling::angle_uniform`], density ∝ 1/α ∝ 1/h near it), and
 //! else as before; the path is weighted by the mixture's density (Veach's
 //! one-sample model, "Robust Monte Carlo Methods for Light Transport
-//! Simulation", 1997, §9.2.4), and so is next-event estimation's balance
+//! Simulation", 1997, §9.2.4), and so is next-event estimation's power
 //! heuristic against area lights, which must know the density with which
 //! the direction could have been drawn. Russian roulette then waits until
 //! the new segment has gathered its light (mod.rs): the small weight of a

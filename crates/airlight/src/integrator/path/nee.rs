@@ -25,7 +25,7 @@
 
 use super::guide::{Guide, mixed_pdf};
 use super::tracking::track;
-use super::{Vertex, avg};
+use super::{Vertex, avg, power_heuristic};
 use crate::Rgb;
 use crate::geometry::{Ray, offset_origin};
 use crate::integrator::Equiangular;
@@ -173,9 +173,9 @@ const LIGHT_SHIFT_KEY: u64 = 0x5bd1_e995_9e37_79b9;
 
 /// Next-event estimation at a vertex: a sample of every light that reaches
 /// it, with a shadow ray and the medium's transmittance, weighted by the
-/// balance heuristic against sampling the BRDF or phase function (area
-/// lights) or against equiangular sampling of the segment (delta lights,
-/// when the medium vertex knows its place on it). `guide`: the lights
+/// power heuristic against sampling the BRDF or phase function (area
+/// lights) or by the balance heuristic against equiangular sampling of the
+/// segment (delta lights, when the medium vertex knows its place on it). `guide`: the lights
 /// toward which the vertex's new direction may also be drawn (guide.rs),
 /// whose density enters the heuristic. Returns the contribution to be
 /// multiplied by the path weight β.
@@ -282,7 +282,7 @@ pub(super) fn direct_light(
             let radiance = ls.weight * ls.pdf;
             let r_l = r_p * r_l * ls.pdf;
             let r_u = r_p * r_u * mixed_pdf(scatter_pdf, guide, ls.wi);
-            total += f * t_ray * radiance / avg(r_l + r_u);
+            total += f * t_ray * radiance * power_heuristic(r_l, r_u, hero);
         }
     });
     total
