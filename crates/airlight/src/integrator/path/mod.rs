@@ -174,8 +174,10 @@ fn avg(v: Rgb) -> f32 {
 /// area lights.
 fn power_heuristic(sampled: Rgb, other: Rgb, hero: usize) -> f32 {
     // The densities divided by their largest first: deep in fog they can
-    // be near f32::MAX, and their squares would overflow. The factor is
-    // of degree −1 in them, hence the last division.
+    // be near f32::MAX, and their squares would overflow (or, far below
+    // one, vanish). The factor is of degree −1 in them, hence the last
+    // division. (Skipping the scaling where the squares' sum is a normal
+    // float saved no measurable time: 1.00×, 8 side-by-side pairs.)
     let scale = sampled.max_element().max(other.max_element());
     if !(scale > 0.0 && scale.is_finite()) {
         return 0.0;
@@ -484,12 +486,17 @@ mod tests {
     #[test]
     fn power_heuristic_survives_densities_near_the_largest_float() {
         // Deep in fog the relative densities can be ~1e38: the factor
-        // scales as 1/p, with no overflow on the way.
+        // scales as 1/p, with no overflow on the way (and no underflow
+        // for densities ~1e-24).
         let (a, b) = (Rgb::new(3.0e38, 1.0e38, 2.0e38), Rgb::new(1.0e38, 2.0e38, 0.5e38));
         let k = 1.0e-37;
         let got = power_heuristic(a, b, 1);
         let want = power_heuristic(a * k, b * k, 1) * k;
         assert!(got.is_finite() && got > 0.0 && (got / want - 1.0).abs() < 1e-5, "{got} against {want}");
+        // And far below one, where the squares vanish.
+        let tiny = 1.0e-25;
+        let got = power_heuristic(a * k * tiny, b * k * tiny, 1) * k * tiny;
+        assert!((got / want - 1.0).abs() < 1e-5, "{got} against {want}");
         assert_eq!(power_heuristic(Rgb::ZERO, Rgb::ZERO, 0), 0.0);
     }
 }
