@@ -26,7 +26,6 @@ use crate::sampling::{Sampler, to_world};
 use crate::scene::Scene;
 use glam::{Vec2, Vec3};
 use guide::{GUIDE_PROBABILITY, Guide, mixed_pdf};
-
 use nee::{Along, Fog, Segment, direct_light, equiangular_applies, equiangular_light};
 use tracking::free_flight;
 
@@ -170,8 +169,7 @@ fn avg(v: Rgb) -> f32 {
 /// to 3, the heroes' count. Against the balance heuristic's
 /// 1 / avg_c(p_s,c + p_o,c), the Cornell box's seed-to-seed error away
 /// from the light fell 3% (0.00200 to 0.00194, 0.00199 to 0.00193; two
-/// seed pairs at 512 spp), as Veach found for diffuse surfaces lit by
-/// area lights.
+/// seed pairs at 512 spp) for 1% more time.
 fn power_heuristic(sampled: Rgb, other: Rgb, hero: usize) -> f32 {
     // The densities divided by their largest first: deep in fog they can
     // be near f32::MAX, and their squares would overflow (or, far below

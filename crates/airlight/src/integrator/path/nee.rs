@@ -175,9 +175,9 @@ const LIGHT_SHIFT_KEY: u64 = 0x5bd1_e995_9e37_79b9;
 /// it, with a shadow ray and the medium's transmittance, weighted by the
 /// power heuristic against sampling the BRDF or phase function (area
 /// lights) or by the balance heuristic against equiangular sampling of the
-/// segment (delta lights, when the medium vertex knows its place on it). `guide`: the lights
-/// toward which the vertex's new direction may also be drawn (guide.rs),
-/// whose density enters the heuristic. Returns the contribution to be
+/// segment (delta lights, when the medium vertex knows its place on it).
+/// `guide`: the lights toward which the vertex's new direction may also be
+/// drawn (guide.rs), whose density enters the heuristic. Returns the contribution to be
 /// multiplied by the path weight β.
 pub(super) fn direct_light(
     scene: &Scene,
