@@ -14,8 +14,9 @@ a grey extinction), renders it with
 Mitsuba's `volpath` (or `path` in vacuum), renders it with `airlight render
 --integrator path` at the same size and sample count, and prints
 `airlight compare` of the two, plus the noise floors: each renderer
-against itself with another seed, from which each image's own error and
-the time each renderer needs for the same error follow (error ∝ 1/√time).
+against itself with other seeds (`--seeds N`, 2 by default: the per-pixel
+variance across N renders), from which each image's own error and the
+time each renderer needs for the same error follow (error ∝ 1/√time).
 A scene whose `[render] integrator` is "direct" runs Mitsuba's `direct`
 (one emitter sample, no BSDF sample) and Airlight's `direct` instead.
 
@@ -281,10 +282,29 @@ def main():
         help="time each renderer this many times and keep the fastest (Airlight: separate runs; "
         "Mitsuba: renders after its warm-up), so that one slow run on a shared machine does not set a figure",
     )
+    p.add_argument(
+        "--seeds",
+        type=int,
+        default=2,
+        help="render each renderer with this many seeds (at least 2) for its own error: the per-pixel variance "
+        "across them; more seeds steady the equal-error ratio where a few pixels hold most of the error",
+    )
     p.add_argument("--out", default=os.path.join(tempfile.gettempdir(), "airlight-mitsuba"))
     args = p.parse_args()
+    if args.seeds < 2:
+        p.error("--seeds must be at least 2: a renderer's own error is measured between seeds")
     import drjit as dr
     import mitsuba as mi
+    import numpy as np
+
+    def own_error(paths):
+        """An image's own relative RMSE, from renders of the same scene
+        with different seeds: √(Σ per-pixel variance across them / Σ
+        mean²), over pixels and channels (for two seeds, their rel_rmse
+        over √2)."""
+        images = np.stack([np.array(mi.Bitmap(p), dtype=np.float64)[..., :3] for p in paths])
+        mean = images.mean(axis=0)
+        return math.sqrt(images.var(axis=0, ddof=1).sum() / (mean**2).sum())
     variants = args.variant or ["llvm_ad_rgb", "scalar_rgb"]
     os.makedirs(args.out, exist_ok=True)
     field = lambda text, key: float([l for l in text.splitlines() if l.startswith(key + ":")][0].split()[1])
@@ -295,15 +315,15 @@ def main():
             integrator = tomllib.load(f).get("render", {}).get("integrator")
         integrator = "direct" if integrator == "direct" else "path"
         ours = os.path.join(args.out, f"{name}.airlight.exr")
-        other = os.path.join(args.out, f"{name}.airlight-seed1.exr")
+        others = [os.path.join(args.out, f"{name}.airlight-seed{k}.exr") for k in range(1, args.seeds)]
         common = ["render", path, "--integrator", integrator, "--spp", str(args.spp)]
         # The same seed gives the same image, so each run rewrites the same file.
         airlight_seconds, airlight_command = min(
             render_seconds(airlight(*common, "-o", ours)[1]) for _ in range(max(1, args.repeat))
         )
-        airlight(*common, "--seed", "1", "-o", other, "--quiet")
-        noise = airlight("compare", ours, other)[0]
-        e_a = field(noise, "rel_rmse") / math.sqrt(2)
+        for k, other in enumerate(others, start=1):
+            airlight(*common, "--seed", str(k), "-o", other, "--quiet")
+        e_a = own_error([ours, *others])
         print(
             f"{name}: {args.spp} spp, {integrator}; Airlight {airlight_seconds:.3f} s "
             f"(command {airlight_command:.3f} s), own error {e_a:.4f}"
@@ -318,14 +338,13 @@ def main():
             )
             ref = os.path.join(args.out, f"{name}.{variant}.exr")
             mi.util.write_bitmap(ref, image, write_async=False)
-            # Mitsuba again with another seed: its own noise, for equal-error times.
-            ref_other = os.path.join(args.out, f"{name}.{variant}-seed1.exr")
-            mi.util.write_bitmap(ref_other, time_mitsuba(mi, dr, scene, args.spp, 1)[1], write_async=False)
+            # Mitsuba again with other seeds: its own noise, for equal-error times.
+            ref_others = [os.path.join(args.out, f"{name}.{variant}-seed{k}.exr") for k in range(1, args.seeds)]
+            for k, ref_other in enumerate(ref_others, start=1):
+                mi.util.write_bitmap(ref_other, time_mitsuba(mi, dr, scene, args.spp, k)[1], write_async=False)
             vs = airlight("compare", ours, ref, "--map", os.path.join(args.out, f"{name}.{variant}.error.png"))[0]
-            mitsuba_noise = airlight("compare", ref, ref_other)[0]
-            # Each image's own error is the seed-to-seed difference over √2;
-            # error falls as 1/√time, so equal error costs time · error².
-            e_m = field(mitsuba_noise, "rel_rmse") / math.sqrt(2)
+            # Error falls as 1/√time, so equal error costs time · error².
+            e_m = own_error([ref, *ref_others])
             # Some samplers round the count up (multijitter: 512 → 528), so
             # the per-sample ratio takes the count each renderer drew.
             mitsuba_spp = scene.sensors()[0].sampler().sample_count()
