@@ -86,8 +86,8 @@ pub struct Geometry {
 /// Up to this many primitives are tested one by one, without the BVH: the
 /// fog comparison scenes (3 and 4 primitives, one a sphere enclosing the
 /// rest, whose box no ray misses) render 8% and 4% faster so than through
-/// the tree, with the same hits. Larger scenes take the quads' lanes
-/// ([`small::SMALL_LIMIT`](super::small::SMALL_LIMIT)) or the tree.
+/// the tree, with the same hits. Larger scenes take the quads' and boxes'
+/// lanes ([`small::SMALL_LIMIT`](super::small::SMALL_LIMIT)) or the tree.
 const LINEAR_LIMIT: usize = 4;
 /// Up to this many primitives, the BVH's leaves hold one primitive each.
 const SMALL_SCENE: usize = 64;

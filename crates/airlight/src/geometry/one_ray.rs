@@ -2,9 +2,9 @@
 //! it, with the box tests and a leaf's triangles in SIMD lanes (eight at a
 //! time where the processor has AVX, found at run time; without it, boxes
 //! and nearest hits four at a time with SSE and shadow rays' triangles one
-//! by one; a portable loop for tests). Every lane type does the same IEEE operations
-//! as the one-triangle functions, so the answers do not depend on the
-//! processor.
+//! by one; a portable loop for tests). Every lane type does the same IEEE
+//! operations as the one-triangle functions, so the answers do not depend
+//! on the processor.
 
 use super::accel::Geometry;
 use super::batch::{comes_before, test_bound};

@@ -76,30 +76,22 @@ pub(super) fn small_scene(records: &[Record]) -> Option<Small> {
     if !fits {
         return None;
     }
-    let quads: Vec<(u32, Vec3, Vec3, Vec3)> = records
-        .iter()
-        .enumerate()
-        .filter_map(|(i, r)| match r.prim {
-            Prim::Quad { corner, edge_u, edge_v } => Some((i as u32, corner, edge_u, edge_v)),
-            _ => None,
-        })
-        .collect();
-    let boxes: Vec<(u32, Option<Affine3A>, Vec3, Vec3)> = records
-        .iter()
-        .enumerate()
-        .filter_map(|(i, r)| as_box(&r.prim).map(|(turn, min, max)| (i as u32, turn, min, max)))
-        .collect();
-    let others: Vec<Other> = (0..records.len() as u32)
-        .filter(|&i| !is_quad(&records[i as usize]) && as_box(&records[i as usize].prim).is_none())
-        .map(|index| {
-            let b = records[index as usize].prim.bounds();
+    // One pass, each record to the first list that takes it, in order.
+    let (mut quads, mut boxes, mut others) = (Vec::new(), Vec::new(), Vec::new());
+    for (index, record) in (0u32..).zip(records) {
+        if let Prim::Quad { corner, edge_u, edge_v } = record.prim {
+            quads.push((index, corner, edge_u, edge_v));
+        } else if let Some((turn, min, max)) = as_box(&record.prim) {
+            boxes.push((index, turn, min, max));
+        } else {
+            let b = record.prim.bounds();
             let (min, max) = (Vec3::from(b.min), Vec3::from(b.max));
             // Generous: a sphere that only just holds the box could lose a
             // grazing hit to rounding.
             let radius = 0.5 * (max - min).length() * 1.001 + 1e-4 * (1.0 + min.abs().max(max.abs()).max_element());
-            Other { index, center: 0.5 * (min + max), radius_squared: radius * radius }
-        })
-        .collect();
+            others.push(Other { index, center: 0.5 * (min + max), radius_squared: radius * radius });
+        }
+    }
     Some(Small { quads: QuadLanes::new(&quads), boxes: BoxLanes::new(&boxes), others })
 }
 
