@@ -116,29 +116,44 @@ fn lambert_irradiance(corner: Vec3, u: Vec3, v: Vec3, radiance: f64) -> f64 {
 }
 
 #[test]
-fn quad_light_on_a_floor_through_the_integrators_matches_lambert() {
+fn quad_and_mesh_lights_on_a_floor_through_the_integrators_match_lambert() {
     // A floor point lit by a quad light, seen through a narrow camera:
     // once found by comparing with Mitsuba 3, shadow rays leaving a point
     // lifted off the floor hit the light itself and a quarter of the light
     // was lost.
+    // And the same parallelogram as an emitting mesh, a fan of four
+    // triangles of unequal areas, which the integrators sample as one
+    // emitter (a triangle drawn by area): the path tracer's weights at a
+    // light hit must know the chance of drawing the triangle, or the
+    // direct light comes out about a tenth short here.
     let (corner, u, v) = (vec3(-0.3, 1.0, -0.4), vec3(1.0, 0.0, 0.0), vec3(0.0, 0.0, 1.2));
-    let scene = SceneBuilder::new()
-        .size(4, 4)
-        .with_settings(|s| s.spp = 4096)
-        .camera(Camera::look_at(vec3(0.0, 0.5, 0.0), Vec3::ZERO, Vec3::Z, 0.5))
-        .material("white", Material::diffuse(Rgb::ONE))
-        .object(Shape::plane(Vec3::ZERO, Vec3::Y), "white")
-        .light(Light::quad(corner, u, v, Rgb::ONE))
-        .build()
-        .unwrap();
+    let fan: Vec<Vec3> = [(0.0, 0.0), (1.0, 0.0), (1.0, 0.3), (1.0, 1.0), (0.4, 1.0), (0.0, 1.0)]
+        .iter()
+        .map(|&(s, t)| corner + s * u + t * v)
+        .collect();
+    let quad = vec![Light::quad(corner, u, v, Rgb::ONE)];
+    let mesh = Light::triangles_of(&fan, &[[0, 1, 2], [0, 2, 3], [0, 3, 4], [0, 4, 5]], Rgb::ONE);
+    assert_eq!(mesh.len(), 4);
     let expected = lambert_irradiance(corner, u, v, 1.0) / std::f64::consts::PI;
-    for (name, integrator) in [
-        ("direct", &Direct as &dyn Integrator),
-        ("path", &airlight::integrator::PathTracer::new(PathOptions { max_depth: 1, ..PathOptions::default() })),
-        ("raymarch", &airlight::integrator::Raymarch::new(RaymarchOptions { steps: 4, jitter: true })),
-    ] {
-        let got = render(&scene, integrator, &RenderObserver::none()).mean().x as f64;
-        assert!((got / expected - 1.0).abs() < 0.01, "{name}: {got} vs {expected}");
+    for (light, lights) in [("quad", quad), ("mesh", mesh)] {
+        let mut builder = SceneBuilder::new()
+            .size(4, 4)
+            .with_settings(|s| s.spp = 4096)
+            .camera(Camera::look_at(vec3(0.0, 0.5, 0.0), Vec3::ZERO, Vec3::Z, 0.5))
+            .material("white", Material::diffuse(Rgb::ONE))
+            .object(Shape::plane(Vec3::ZERO, Vec3::Y), "white");
+        for l in lights {
+            builder = builder.light(l);
+        }
+        let scene = builder.build().unwrap();
+        for (name, integrator) in [
+            ("direct", &Direct as &dyn Integrator),
+            ("path", &airlight::integrator::PathTracer::new(PathOptions { max_depth: 1, ..PathOptions::default() })),
+            ("raymarch", &airlight::integrator::Raymarch::new(RaymarchOptions { steps: 4, jitter: true })),
+        ] {
+            let got = render(&scene, integrator, &RenderObserver::none()).mean().x as f64;
+            assert!((got / expected - 1.0).abs() < 0.01, "{name}, {light} light: {got} vs {expected}");
+        }
     }
 }
 

@@ -1,7 +1,9 @@
 //! Emitting objects: a mesh with `emission` becomes one triangle light per
-//! triangle. A square of two emitting triangles must light a room as the
-//! quad light of the same radiance does, in every integrator that takes
-//! area lights, and look the same to the camera.
+//! triangle. A square of four emitting triangles of unequal areas must
+//! light a room as the quad light of the same radiance does, in every
+//! integrator that takes area lights (those that sample the mesh as one
+//! emitter, a triangle drawn by area, and those that visit each triangle),
+//! and look the same to the camera.
 
 use airlight::SceneFile;
 use airlight::film::Accumulator;
@@ -64,9 +66,11 @@ file = "square.obj"
 emission = [6, 5, 4]
 "#;
 
-/// The same square as two triangles, wound to face down (OBJ's
-/// counter-clockwise front).
-const SQUARE_OBJ: &str = "v -0.5 1.5 -0.5\nv 0.5 1.5 -0.5\nv 0.5 1.5 0.5\nv -0.5 1.5 0.5\nf 1 2 3\nf 1 3 4\n";
+/// The same square as a fan of four triangles from one corner, of areas
+/// 0.15, 0.35, 0.2 and 0.3, wound to face down (OBJ's counter-clockwise
+/// front).
+const SQUARE_OBJ: &str = "v -0.5 1.5 -0.5\nv 0.5 1.5 -0.5\nv 0.5 1.5 -0.2\nv 0.5 1.5 0.5\nv 0.1 1.5 0.5\nv -0.5 1.5 0.5\n\
+                          f 1 2 3\nf 1 3 4\nf 1 4 5\nf 1 5 6\n";
 
 fn load(text: &str) -> SceneFile {
     let dir = tempfile::tempdir().unwrap();
@@ -116,7 +120,17 @@ fn assert_agree(what: &str, a: &Accumulator, b: &Accumulator, tolerance: f64) {
 fn an_emitting_mesh_becomes_one_triangle_light_per_triangle() {
     let file = load(&scene_text(MESH_LIGHT, false));
     let lights = file.scene.lights();
-    assert_eq!(lights.len(), 2);
+    assert_eq!(lights.len(), 4);
+    let areas: Vec<f32> = lights
+        .iter()
+        .map(|light| match *light {
+            Light::Triangle { edge_1, edge_2, .. } => 0.5 * edge_1.cross(edge_2).length(),
+            _ => 0.0,
+        })
+        .collect();
+    for (area, want) in areas.iter().zip([0.15, 0.35, 0.2, 0.3]) {
+        assert!((area - want).abs() < 1e-6, "{areas:?}");
+    }
     for light in lights {
         let Light::Triangle { edge_1, edge_2, radiance, .. } = *light else { panic!("not a triangle: {light:?}") };
         assert!(edge_1.cross(edge_2).y < 0.0, "faces down as the file winds it");
@@ -145,7 +159,7 @@ fn a_square_of_emitting_triangles_lights_fog_as_its_quad_light() {
         let quad = render(&scene_text(QUAD_LIGHT, true), kind, spp);
         let mesh = render(&scene_text(MESH_LIGHT, true), kind, spp);
         // The analytic integrator sums Gauss points over each light: a
-        // square's and two triangles' points differ; 1% for that.
+        // square's and four triangles' points differ; 1% for that.
         assert_agree(&format!("{kind:?} in fog"), &quad, &mesh, 0.01);
     }
 }

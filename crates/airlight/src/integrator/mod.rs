@@ -273,8 +273,10 @@ pub(crate) fn emitted(scene: &Scene, ray: &Ray, surface: &SurfaceHit) -> Rgb {
 }
 
 /// Calls `term(light, sample, f · weight · |cos|)` for one sample of each
-/// light that may reach the surface, in the lights' order, before any
-/// shadow ray: the terms that direct light adds where the light is seen.
+/// emitter that may reach the surface (a light, or an emitting mesh's
+/// triangles together: [`Scene::for_each_emitter_at`]), in the lights'
+/// order, before any shadow ray: the terms that direct light adds where the
+/// light is seen.
 /// Takes one key from `sampler`, whatever the number of lights.
 pub(crate) fn for_each_light_term(
     scene: &Scene,
@@ -286,9 +288,9 @@ pub(crate) fn for_each_light_term(
     let wo = -ray.dir;
     let material = scene.material_at(surface);
     let key = sampler.next_key();
-    scene.for_each_light_at(surface.p, |index, _| {
+    scene.for_each_emitter_at(surface.p, |index, _| {
         let u = keyed2(key, index as u64);
-        let Some(sample) = scene.sample_light(index, surface.p, u) else { return };
+        let Some(sample) = scene.sample_emitter(index, surface.p, u) else { return };
         let cos = sample.wi.dot(surface.n).abs();
         if cos == 0.0 {
             return;

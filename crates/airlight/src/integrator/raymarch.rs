@@ -112,9 +112,9 @@ pub fn in_scattered(
         }
         let mut light_in = Rgb::ZERO;
         let key = sampler.next_key();
-        scene.for_each_light_at(p, |index, _| {
+        scene.for_each_emitter_at(p, |index, _| {
             let u = keyed2(key, index as u64);
-            let Some(sample) = scene.sample_light(index, p, u) else { return };
+            let Some(sample) = scene.sample_emitter(index, p, u) else { return };
             if !scene.unoccluded(p, None, &sample) {
                 return;
             }

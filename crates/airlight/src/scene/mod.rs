@@ -15,6 +15,7 @@ mod build_lights;
 mod build_materials;
 mod build_medium;
 pub mod desc;
+mod emitters;
 mod error;
 mod gltf;
 mod lights;
@@ -40,6 +41,7 @@ use crate::geometry::{Geometry, GeometryBuilder, Segment, Shape, SurfaceHit, off
 use crate::light::{Keyframes, Light, LightSample};
 use crate::material::Material;
 use crate::medium::Medium;
+use emitters::Emitters;
 use glam::{Affine3A, Vec2, Vec3};
 use std::collections::HashMap;
 
@@ -156,6 +158,9 @@ pub struct Scene {
     bounds_center: Vec3,
     bounds_radius: f32,
     light_culling: LightCulling,
+    /// The lights grouped for sampling: an emitting mesh's triangles as one
+    /// (see [`Scene::for_each_emitter_at`]).
+    emitters: Emitters,
     /// The indices of the delta lights with a place (see
     /// [`Scene::placed_delta_lights`]).
     placed_delta: Vec<u32>,
@@ -306,6 +311,7 @@ impl Scene {
         self.lights = lights.to_vec();
         self.light_paths.resize(self.lights.len(), None);
         self.light_culling = LightCulling::new(&self.lights);
+        self.emitters = Emitters::new(&self.lights);
         self.placed_delta = placed_delta(&self.lights);
         if surfaces_moved {
             self.geometry = build_geometry(self.surfaces());
@@ -427,6 +433,46 @@ impl Scene {
         };
         // A reused buffer, or a fresh one if a caller nests these loops.
         crate::scratch::with_scratch(&FOUND, visit);
+    }
+
+    /// Calls `f(index, light)` for every emitter that may reach `p`, in
+    /// index order: as [`Scene::for_each_light_at`], but a run of triangle
+    /// lights of the same radiance (an emitting mesh) is one emitter,
+    /// visited once at its first light; [`Scene::sample_emitter`] then
+    /// draws one of its triangles. A shading point so traces one shadow
+    /// ray per mesh rather than one per triangle.
+    pub fn for_each_emitter_at(&self, p: Vec3, mut f: impl FnMut(usize, &Light)) {
+        if !self.settings.cull_lights || !self.light_culling.has_ranges() {
+            for &i in self.emitters.firsts() {
+                f(i as usize, &self.lights[i as usize]);
+            }
+            return;
+        }
+        // Triangle lights have no range, so culling keeps whole runs.
+        self.for_each_light_at(p, |i, light| {
+            if self.emitters.is_first(i) {
+                f(i, light)
+            }
+        });
+    }
+
+    /// Light from the emitter that starts at light `first` (see
+    /// [`Scene::for_each_emitter_at`]) arriving at `p`: for an emitting
+    /// mesh, a triangle drawn in proportion to its area and a point of it,
+    /// so a point uniform by area over the mesh, with the density of both
+    /// choices; for any other light, [`Scene::sample_light`].
+    #[inline]
+    pub fn sample_emitter(&self, first: usize, p: Vec3, u: Vec2) -> Option<LightSample> {
+        self.emitters.sample(&self.lights, first, p, u).filter(|s| s.weight != Rgb::ZERO)
+    }
+
+    /// The solid-angle density with which [`Scene::sample_emitter`] draws
+    /// direction `wi` from `p` toward light `index`, met at distance `t`:
+    /// [`Light::pdf`] times the chance of drawing the light within its
+    /// emitter.
+    #[inline]
+    pub fn emitter_pdf(&self, index: usize, p: Vec3, wi: Vec3, t: f32) -> f32 {
+        self.lights[index].pdf(p, wi, t) * self.emitters.chance(index)
     }
 
     /// Replaces the falloff model of every point, spot and sphere light
@@ -558,6 +604,7 @@ impl SceneBuilder {
             placed.push((shape, material));
         }
         let light_culling = LightCulling::new(&lights);
+        let emitters = Emitters::new(&lights);
         let placed_delta = placed_delta(&lights);
         let mut scene = Scene {
             settings,
@@ -571,6 +618,7 @@ impl SceneBuilder {
             bounds_center: Vec3::ZERO,
             bounds_radius: 1.0,
             light_culling,
+            emitters,
             placed_delta,
             files: Vec::new(),
             notes: Vec::new(),

@@ -359,7 +359,8 @@ impl PathTracer {
                     } else {
                         // A light that next-event estimation samples as a
                         // point (an approximated sphere) was counted there.
-                        let light_pdf = light.pdf(prev_p, ray.dir, (surface.p - prev_p).length());
+                        let light_pdf =
+                            scene.emitter_pdf(index as usize, prev_p, ray.dir, (surface.p - prev_p).length());
                         if light_pdf > 0.0 {
                             let r_l = r_l * light_pdf;
                             l += beta * le * power_heuristic(r_u, r_l, hero);

@@ -171,14 +171,16 @@ pub(super) struct Fog<'a> {
 /// numbers ([`direct_light`]).
 const LIGHT_SHIFT_KEY: u64 = 0x5bd1_e995_9e37_79b9;
 
-/// Next-event estimation at a vertex: a sample of every light that reaches
-/// it, with a shadow ray and the medium's transmittance, weighted by the
-/// power heuristic against sampling the BRDF or phase function (area
-/// lights) or by the balance heuristic against equiangular sampling of the
-/// segment (delta lights, when the medium vertex knows its place on it).
-/// `guide`: the lights toward which the vertex's new direction may also be
-/// drawn (guide.rs), whose density enters the heuristic. Returns the contribution to be
-/// multiplied by the path weight β.
+/// Next-event estimation at a vertex: a sample of every emitter that
+/// reaches it (each light, but an emitting mesh's triangles as one:
+/// [`Scene::for_each_emitter_at`]), with a shadow ray and the medium's
+/// transmittance, weighted by the power heuristic against sampling the
+/// BRDF or phase function (area lights) or by the balance heuristic
+/// against equiangular sampling of the segment (delta lights, when the
+/// medium vertex knows its place on it). `guide`: the lights toward which
+/// the vertex's new direction may also be drawn (guide.rs), whose density
+/// enters the heuristic. Returns the contribution to be multiplied by the
+/// path weight β.
 pub(super) fn direct_light(
     scene: &Scene,
     fog: Fog,
@@ -200,7 +202,7 @@ pub(super) fn direct_light(
     };
     let key = sampler.next_key();
     let mut total = Rgb::ZERO;
-    scene.for_each_light_at(p, |index, light| {
+    scene.for_each_emitter_at(p, |index, light| {
         let u = match stratified {
             // Each light's points shifted by its own fixed offset (mod 1):
             // still evenly spread, and not the same as another light's.
@@ -212,7 +214,7 @@ pub(super) fn direct_light(
             }
             None => keyed2(key, index as u64),
         };
-        let Some(ls) = scene.sample_light(index, p, u) else { return };
+        let Some(ls) = scene.sample_emitter(index, p, u) else { return };
         let (f, scatter_pdf, normal) = match *vertex {
             Vertex::Surface { p, n, material: m, .. } => {
                 let (brdf, pdf) = m.eval(p, n, wo, ls.wi);
