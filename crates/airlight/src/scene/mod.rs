@@ -18,6 +18,7 @@ pub mod desc;
 mod emitters;
 mod error;
 mod gltf;
+mod light_queries;
 mod lights;
 pub mod limits;
 mod mesh;
@@ -37,12 +38,12 @@ pub use lights::LightCulling;
 use crate::Rgb;
 use crate::camera::Camera;
 use crate::film::Tonemap;
-use crate::geometry::{Geometry, GeometryBuilder, Segment, Shape, SurfaceHit, offset_origin};
-use crate::light::{Keyframes, Light, LightSample};
+use crate::geometry::{Geometry, GeometryBuilder, Shape, SurfaceHit};
+use crate::light::{Keyframes, Light};
 use crate::material::Material;
 use crate::medium::Medium;
 use emitters::Emitters;
-use glam::{Affine3A, Vec2, Vec3};
+use glam::{Affine3A, Vec3};
 use std::collections::HashMap;
 
 /// The film and sampling settings of `[render]`: what every integrator
@@ -347,132 +348,6 @@ impl Scene {
 
     fn update_bounds(&mut self) {
         (self.bounds_center, self.bounds_radius) = bounding_sphere(&self.geometry, &self.lights, &self.camera);
-    }
-
-    /// The distance a shadow ray toward a light sample should span: the
-    /// sample's distance, or for a sun, across the scene's bounding sphere.
-    pub fn light_distance(&self, distance: f32) -> f32 {
-        if distance.is_finite() { distance } else { 2.0 * self.bounds_radius }
-    }
-
-    /// Light from light `index` arriving at `p`, drawn with the uniform
-    /// numbers `u` (see [`Light::sample`]: a volume light makes a third
-    /// from these two); None when the light sends none there. Blockers are
-    /// not tested: see [`Scene::unoccluded`]. Every light-sampling loop
-    /// goes through here or [`Scene::sample_light3`].
-    #[inline]
-    pub fn sample_light(&self, index: usize, p: Vec3, u: Vec2) -> Option<LightSample> {
-        self.lights[index].sample(p, u).filter(|s| s.weight != Rgb::ZERO)
-    }
-
-    /// [`Scene::sample_light`] with three uniform numbers, all of which a
-    /// volume light uses (others the first two).
-    #[inline]
-    pub fn sample_light3(&self, index: usize, p: Vec3, u: Vec3) -> Option<LightSample> {
-        self.lights[index].sample3(p, u).filter(|s| s.weight != Rgb::ZERO)
-    }
-
-    /// Whether nothing blocks `sample` (a light sample seen from `p`). On a
-    /// surface, give its normal: the shadow ray starts lifted off it.
-    #[inline]
-    pub fn unoccluded(&self, p: Vec3, normal: Option<Vec3>, sample: &LightSample) -> bool {
-        let origin = match normal {
-            Some(n) => offset_origin(p, n, sample.wi),
-            None => p,
-        };
-        self.light_visible(p, origin, sample.wi, sample.distance)
-    }
-
-    /// Whether the light sample at `p + wi·distance` (a sun's when distance
-    /// is infinite) is visible from `origin`, which is `p` or `p` lifted off
-    /// its surface. The shadow ray aims from `origin` at the sample point
-    /// itself and stops just short of it. Keeping the direction wi from the
-    /// lifted origin would not do: that ray runs beside the sample point, and
-    /// where it meets the light's own surface at a slant (a floor point
-    /// seeing a ceiling light at 50° or more from the vertical) it meets it
-    /// before any span measured along wi ends, and calls the light a blocker
-    /// of itself (the Cornell box's one-bounce walls read 5.5% dark so).
-    #[inline]
-    pub fn light_visible(&self, p: Vec3, origin: Vec3, wi: Vec3, distance: f32) -> bool {
-        self.light_segment(p, origin, wi, distance).is_some_and(|s| !self.geometry.occluded(s.origin, s.dir, s.tmax))
-    }
-
-    /// The shadow ray that [`Scene::light_visible`] traces, or None where
-    /// it traces none and answers "not visible" (the sample point is the
-    /// origin itself): for callers that trace many at once
-    /// ([`Geometry::occluded_packet`]).
-    #[inline]
-    pub fn light_segment(&self, p: Vec3, origin: Vec3, wi: Vec3, distance: f32) -> Option<Segment> {
-        const SHORT: f32 = 1.0 - 1e-4;
-        if !distance.is_finite() {
-            return Some(Segment { origin, dir: wi, tmax: 2.0 * self.bounds_radius * SHORT });
-        }
-        let to = p + wi * distance - origin;
-        let length = to.length();
-        (length > 0.0).then(|| Segment { origin, dir: to / length, tmax: length * SHORT })
-    }
-
-    /// Calls `f(index, light)` for every light that may reach `p`, in index
-    /// order: with culling, lights whose range ends before `p` are skipped
-    /// without being looked at.
-    pub fn for_each_light_at(&self, p: Vec3, mut f: impl FnMut(usize, &Light)) {
-        if !self.settings.cull_lights || !self.light_culling.has_ranges() {
-            for (i, light) in self.lights.iter().enumerate() {
-                f(i, light);
-            }
-            return;
-        }
-        thread_local! {
-            static FOUND: std::cell::RefCell<Vec<u32>> = const { std::cell::RefCell::new(Vec::new()) };
-        }
-        let visit = |found: &mut Vec<u32>| {
-            self.light_culling.lights_at(p, found);
-            for &i in found.iter() {
-                f(i as usize, &self.lights[i as usize]);
-            }
-        };
-        // A reused buffer, or a fresh one if a caller nests these loops.
-        crate::scratch::with_scratch(&FOUND, visit);
-    }
-
-    /// Calls `f(index, light)` for every emitter that may reach `p`, in
-    /// index order: as [`Scene::for_each_light_at`], but a run of triangle
-    /// lights of the same radiance (an emitting mesh) is one emitter,
-    /// visited once at its first light; [`Scene::sample_emitter`] then
-    /// draws one of its triangles. A shading point so traces one shadow
-    /// ray per mesh rather than one per triangle.
-    pub fn for_each_emitter_at(&self, p: Vec3, mut f: impl FnMut(usize, &Light)) {
-        if !self.settings.cull_lights || !self.light_culling.has_ranges() {
-            for &i in self.emitters.firsts() {
-                f(i as usize, &self.lights[i as usize]);
-            }
-            return;
-        }
-        // Triangle lights have no range, so culling keeps whole runs.
-        self.for_each_light_at(p, |i, light| {
-            if self.emitters.is_first(i) {
-                f(i, light)
-            }
-        });
-    }
-
-    /// Light from the emitter that starts at light `first` (see
-    /// [`Scene::for_each_emitter_at`]) arriving at `p`: for an emitting
-    /// mesh, a triangle drawn in proportion to its area and a point of it,
-    /// so a point uniform by area over the mesh, with the density of both
-    /// choices; for any other light, [`Scene::sample_light`].
-    #[inline]
-    pub fn sample_emitter(&self, first: usize, p: Vec3, u: Vec2) -> Option<LightSample> {
-        self.emitters.sample(&self.lights, first, p, u).filter(|s| s.weight != Rgb::ZERO)
-    }
-
-    /// The solid-angle density with which [`Scene::sample_emitter`] draws
-    /// direction `wi` from `p` toward light `index`, met at distance `t`:
-    /// [`Light::pdf`] times the chance of drawing the light within its
-    /// emitter.
-    #[inline]
-    pub fn emitter_pdf(&self, index: usize, p: Vec3, wi: Vec3, t: f32) -> f32 {
-        self.lights[index].pdf(p, wi, t) * self.emitters.chance(index)
     }
 
     /// Replaces the falloff model of every point, spot and sphere light
