@@ -37,7 +37,7 @@ use crate::geometry::Ray;
 use crate::medium::Medium;
 use crate::sampling::Sampler;
 use crate::scene::Scene;
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 
 /// How the point on the camera segment is drawn.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
@@ -115,8 +115,9 @@ impl Stochastic {
 }
 
 impl Stochastic {
-    /// One sample per light of the light scattered toward the ray's origin
-    /// over [0, length].
+    /// One sample per light (an emitting mesh's triangles as one light:
+    /// [`Scene::for_each_emitter_at`]) of the light scattered toward the
+    /// ray's origin over [0, length].
     fn in_scattered(&self, scene: &Scene, medium: &Medium, ray: &Ray, length: f32, sampler: &mut Sampler) -> Rgb {
         let mut total = Rgb::ZERO;
         if medium.sigma_s == Rgb::ZERO || length <= 0.0 {
@@ -125,13 +126,17 @@ impl Stochastic {
         // Points are drawn where the medium may have density (a grid's box).
         let Some(span) = medium.extent(ray.origin, ray.dir, 0.0, length) else { return total };
         let wo = -ray.dir;
-        for (index, light) in scene.lights().iter().enumerate() {
+        for &first in scene.emitter_firsts() {
             let u = if self.stratify {
-                sampler.stratified4(1 + index as u32)
+                sampler.stratified4(1 + first)
             } else {
                 [sampler.next(), sampler.next(), sampler.next(), sampler.next()]
             };
-            let u_light = Vec3::new(u[1], u[2], u[3]);
+            // The emitter's light first (itself, or a triangle of a mesh),
+            // whose anchor the distance is drawn about.
+            let (index, chance, u_light) = scene.draw_emitter(first as usize, Vec2::new(u[1], u[2]));
+            let light = &scene.lights()[index];
+            let u_light = u_light.extend(u[3]);
             let Some((t, pdf)) = self.distance(ray, span, light.anchor(), u[0]) else { continue };
             let x = ray.at(t);
             let Some(sample) = scene.sample_light3(index, x, u_light) else { continue };
@@ -143,7 +148,7 @@ impl Stochastic {
             let to_light = medium.transmittance(x, sample.wi, 0.0, distance);
             let phase = medium.phase(wo, sample.wi);
             let sigma_s = medium.sigma_s * medium.density_at(x);
-            total += to_eye * sigma_s * phase * sample.weight * to_light / pdf;
+            total += to_eye * sigma_s * phase * sample.weight * to_light / (pdf * chance);
         }
         total
     }

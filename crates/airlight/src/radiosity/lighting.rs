@@ -14,19 +14,20 @@ use crate::scene::Scene;
 use glam::{Vec2, Vec3A};
 use rayon::prelude::*;
 
-/// Samples per patch for an area (sphere or quad) light. One suffices:
-/// a patch's direct light only feeds the bounce, where each receiver sums
-/// hundreds of sources whose sample positions differ (a fixed hash per
-/// patch, so a still light gives the same value every frame), while the
-/// integrator evaluates direct light per pixel.
+/// Samples per patch for an area light (a sphere, a quad or an emitting
+/// mesh). One suffices: a patch's direct light only feeds the bounce,
+/// where each receiver sums hundreds of sources whose sample positions
+/// differ (a fixed hash per patch, so a still light gives the same value
+/// every frame), while the integrator evaluates direct light per pixel.
 pub const AREA_LIGHT_SAMPLES: u32 = 1;
 /// Patches per parallel work item.
 const CHUNK: usize = 256;
 
 /// Irradiance from the scene's lights at every patch's centre, on the patch's side,
-/// with shadow rays: delta lights once, area lights with
-/// [`AREA_LIGHT_SAMPLES`] stratified samples whose offsets are fixed per
-/// patch, so a still light gives the same value every frame.
+/// with shadow rays: delta lights once, area lights (an emitting mesh as
+/// one, [`Scene::for_each_emitter_at`]) with [`AREA_LIGHT_SAMPLES`]
+/// stratified samples whose offsets are fixed per patch, so a still light
+/// gives the same value every frame.
 pub fn direct(scene: &Scene, patches: &[Patch], seed: u64, out: &mut [Rgb]) {
     out.par_chunks_mut(CHUNK).enumerate().for_each(|(c, chunk)| {
         for (k, e) in chunk.iter_mut().enumerate() {
@@ -39,7 +40,7 @@ pub fn direct(scene: &Scene, patches: &[Patch], seed: u64, out: &mut [Rgb]) {
 fn patch_irradiance(scene: &Scene, p: &Patch, key: u64) -> Rgb {
     let mut e = Rgb::ZERO;
     let jitter = Vec2::new((key & 0xffff) as f32 / 65536.0, ((key >> 16) & 0xffff) as f32 / 65536.0);
-    for (index, light) in scene.lights().iter().enumerate() {
+    scene.for_each_emitter_at(p.center, |index, light| {
         let count = if light.is_delta() { 1 } else { AREA_LIGHT_SAMPLES };
         let side = (count as f32).sqrt().ceil() as u32;
         let mut sum = Rgb::ZERO;
@@ -49,7 +50,7 @@ fn patch_irradiance(scene: &Scene, p: &Patch, key: u64) -> Rgb {
             } else {
                 Vec2::new(((s % side) as f32 + jitter.x) / side as f32, ((s / side) as f32 + jitter.y) / side as f32)
             };
-            let Some(sample) = scene.sample_light(index, p.center, u) else {
+            let Some(sample) = scene.sample_emitter(index, p.center, u) else {
                 continue;
             };
             let cos = sample.wi.dot(p.normal);
@@ -59,7 +60,7 @@ fn patch_irradiance(scene: &Scene, p: &Patch, key: u64) -> Rgb {
             sum += sample.weight * cos;
         }
         e += sum / count as f32;
-    }
+    });
     e
 }
 

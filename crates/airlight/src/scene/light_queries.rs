@@ -117,6 +117,22 @@ impl Scene {
         });
     }
 
+    /// The emitters' first lights, in index order: each light, but of a
+    /// run of triangle lights of the same radiance (an emitting mesh) only
+    /// the first ([`Scene::for_each_emitter_at`] without culling).
+    pub fn emitter_firsts(&self) -> &[u32] {
+        self.emitters.firsts()
+    }
+
+    /// Draws a light of the emitter that starts at light `first` with
+    /// `u.x`: for an emitting mesh a triangle, with a chance in proportion
+    /// to its area; else the light itself, with chance 1. Returns the
+    /// light's index, the chance, and `u` with `u.x` stretched back over
+    /// [0, 1) within the light's share, to sample the light with.
+    pub fn draw_emitter(&self, first: usize, u: Vec2) -> (usize, f32, Vec2) {
+        self.emitters.draw(first, u)
+    }
+
     /// Light from the emitter that starts at light `first` (see
     /// [`Scene::for_each_emitter_at`]) arriving at `p`: for an emitting
     /// mesh, a triangle drawn in proportion to its area and a point of it,
