@@ -36,7 +36,7 @@ fn scene(cull: bool) -> Scene {
 fn main() {
     let (culled, full) = (scene(true), scene(false));
     let mut reach = 0;
-    culled.for_each_light_at(Vec3::ZERO, |_, _| reach += 1);
+    culled.for_each_emitter_at(Vec3::ZERO, |_, _| reach += 1);
     println!("1000 point lights, range {:.2}; {reach} reach the origin", culled.lights()[0].reach().unwrap().1);
     for round in 0..2 {
         let t = Instant::now();

@@ -52,6 +52,34 @@ fn culling_lights_out_of_range_leaves_the_image_unchanged() {
     // The lights have a short reach: most are out of range of any one point.
     let scene = many_lights(true);
     let mut reached = 0;
-    scene.for_each_light_at(Vec3::ZERO, |_, _| reached += 1);
+    scene.for_each_emitter_at(Vec3::ZERO, |_, _| reached += 1);
     assert!(reached < 50, "{reached} lights reach the origin");
+}
+
+/// An emitting mesh is one emitter with culling as without it: a point is
+/// visited by its first triangle alone, beside the lights in range.
+#[test]
+fn an_emitting_mesh_is_visited_once_with_culling_as_without() {
+    let positions = [vec3(-1.0, 3.0, -1.0), vec3(1.0, 3.0, -1.0), vec3(1.0, 3.0, 1.0), vec3(-1.0, 3.0, 1.0)];
+    let mesh = Light::triangles_of(&positions, &[[0, 2, 1], [0, 3, 2], [0, 1, 3]], Rgb::ONE);
+    assert_eq!(mesh.len(), 3);
+    let near = Attenuation::new(AttenuationModel::WindowRational, 0.05, 100.0, None, Some(2.0)).unwrap();
+    for cull in [true, false] {
+        let mut b = SceneBuilder::new()
+            .with_settings(|s| s.cull_lights = cull)
+            .material("floor", Material::diffuse(Rgb::ONE))
+            .object(Shape::plane(Vec3::ZERO, Vec3::Y), "floor")
+            .light(Light::point(vec3(0.0, 0.5, 0.0), Rgb::ONE).with_attenuation(near))
+            .light(Light::point(vec3(9.0, 0.5, 0.0), Rgb::ONE).with_attenuation(near));
+        for light in &mesh {
+            b = b.light(*light);
+        }
+        let scene = b.build().unwrap();
+        assert!(scene.light_culling().has_ranges());
+        let mut visited = Vec::new();
+        scene.for_each_emitter_at(Vec3::ZERO, |index, _| visited.push(index));
+        // The near light, the far one unless culled, and the mesh at its first triangle.
+        let expected = if cull { vec![0, 2] } else { vec![0, 1, 2] };
+        assert_eq!(visited, expected, "cull_lights = {cull}");
+    }
 }

@@ -66,11 +66,6 @@ impl Emitters {
         &self.firsts
     }
 
-    /// Whether light `index` is its emitter's first.
-    pub fn is_first(&self, index: usize) -> bool {
-        self.first_of[index] as usize == index
-    }
-
     /// The chance of drawing light `index` within its emitter: the step of
     /// the cumulative table at it, so that it is exactly the measure of
     /// the numbers that [`Emitters::draw`] maps to it.
@@ -170,6 +165,25 @@ mod tests {
         }
         assert_eq!(emitters.chance(0), 1.0);
         assert_eq!(emitters.chance(11), 1.0);
+    }
+
+    /// A triangle far too small for an f32 chance is never drawn, and says
+    /// so (chance 0), so that a light hit found by a BRDF or phase sample
+    /// takes the whole weight there.
+    #[test]
+    fn a_triangle_too_small_to_draw_has_chance_zero() {
+        let big = Light::triangle(Vec3::ZERO, vec3(0.0, 0.0, 1.0), Vec3::X, Rgb::ONE);
+        let tiny = Light::triangle(Vec3::ZERO, vec3(0.0, 0.0, 1e-6), vec3(1e-6, 0.0, 0.0), Rgb::ONE);
+        let emitters = Emitters::new(&[big, tiny, big]);
+        assert_eq!(emitters.firsts(), &[0]);
+        assert_eq!(emitters.chance(1), 0.0);
+        assert_eq!(emitters.chance(0) + emitters.chance(2), 1.0);
+        for j in 0..1000 {
+            let (index, chance, _) = emitters.draw(0, Vec2::new(j as f32 / 1000.0, 0.5));
+            assert!(index != 1 && chance > 0.0, "u = {}", j as f32 / 1000.0);
+        }
+        // u.x right at the first triangle's end draws the third.
+        assert_eq!(emitters.draw(0, Vec2::new(emitters.cumulative[0], 0.5)).0, 2);
     }
 
     #[test]

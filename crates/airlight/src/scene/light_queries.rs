@@ -73,19 +73,24 @@ impl Scene {
         (length > 0.0).then(|| Segment { origin, dir: to / length, tmax: length * SHORT })
     }
 
-    /// Calls `f(index, light)` for every light that may reach `p`, in index
-    /// order: with culling, lights whose range ends before `p` are skipped
-    /// without being looked at.
-    pub fn for_each_light_at(&self, p: Vec3, mut f: impl FnMut(usize, &Light)) {
+    /// Calls `f(index, light)` for every emitter that may reach `p`, in
+    /// index order: each light, but a run of triangle lights of the same
+    /// radiance (an emitting mesh) as one emitter, visited once at its
+    /// first light, of which [`Scene::sample_emitter`] then draws one
+    /// triangle; a shading point so traces one shadow ray per mesh rather
+    /// than one per triangle. With culling, lights whose range ends before
+    /// `p` are skipped without being looked at.
+    pub fn for_each_emitter_at(&self, p: Vec3, mut f: impl FnMut(usize, &Light)) {
         if !self.settings.cull_lights || !self.light_culling.has_ranges() {
-            for (i, light) in self.lights.iter().enumerate() {
-                f(i, light);
+            for &i in self.emitters.firsts() {
+                f(i as usize, &self.lights[i as usize]);
             }
             return;
         }
         thread_local! {
             static FOUND: std::cell::RefCell<Vec<u32>> = const { std::cell::RefCell::new(Vec::new()) };
         }
+        // The culling holds the emitters' first lights only.
         let visit = |found: &mut Vec<u32>| {
             self.light_culling.lights_at(p, found);
             for &i in found.iter() {
@@ -94,27 +99,6 @@ impl Scene {
         };
         // A reused buffer, or a fresh one if a caller nests these loops.
         crate::scratch::with_scratch(&FOUND, visit);
-    }
-
-    /// Calls `f(index, light)` for every emitter that may reach `p`, in
-    /// index order: as [`Scene::for_each_light_at`], but a run of triangle
-    /// lights of the same radiance (an emitting mesh) is one emitter,
-    /// visited once at its first light; [`Scene::sample_emitter`] then
-    /// draws one of its triangles. A shading point so traces one shadow
-    /// ray per mesh rather than one per triangle.
-    pub fn for_each_emitter_at(&self, p: Vec3, mut f: impl FnMut(usize, &Light)) {
-        if !self.settings.cull_lights || !self.light_culling.has_ranges() {
-            for &i in self.emitters.firsts() {
-                f(i as usize, &self.lights[i as usize]);
-            }
-            return;
-        }
-        // Triangle lights have no range, so culling keeps whole runs.
-        self.for_each_light_at(p, |i, light| {
-            if self.emitters.is_first(i) {
-                f(i, light)
-            }
-        });
     }
 
     /// The emitters' first lights, in index order: each light, but of a
@@ -143,12 +127,11 @@ impl Scene {
         self.emitters.sample(&self.lights, first, p, u).filter(|s| s.weight != Rgb::ZERO)
     }
 
-    /// The solid-angle density with which [`Scene::sample_emitter`] draws
-    /// direction `wi` from `p` toward light `index`, met at distance `t`:
-    /// [`Light::pdf`] times the chance of drawing the light within its
-    /// emitter.
+    /// The chance with which [`Scene::sample_emitter`] draws light `index`
+    /// within its emitter (1 for a light alone): the solid-angle density of
+    /// its samples is [`Light::pdf`] times this.
     #[inline]
-    pub fn emitter_pdf(&self, index: usize, p: Vec3, wi: Vec3, t: f32) -> f32 {
-        self.lights[index].pdf(p, wi, t) * self.emitters.chance(index)
+    pub fn emitter_chance(&self, index: usize) -> f32 {
+        self.emitters.chance(index)
     }
 }

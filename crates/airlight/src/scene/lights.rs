@@ -36,13 +36,16 @@ impl Boundable for Reach {
 }
 
 impl LightCulling {
-    pub fn new(lights: &[Light]) -> Self {
+    /// The culling of lights `candidates` (indices into `lights`, in
+    /// increasing order): the scene passes its emitters' first lights, so
+    /// that an emitting mesh's triangles are not each walked per point.
+    pub fn new(lights: &[Light], candidates: &[u32]) -> Self {
         let mut unbounded = Vec::new();
         let mut bounded = Vec::new();
-        for (i, light) in lights.iter().enumerate() {
-            match light.reach() {
-                Some((center, reach)) => bounded.push((i as u32, center, reach)),
-                None => unbounded.push(i as u32),
+        for &i in candidates {
+            match lights[i as usize].reach() {
+                Some((center, reach)) => bounded.push((i, center, reach)),
+                None => unbounded.push(i),
             }
         }
         if bounded.is_empty() {

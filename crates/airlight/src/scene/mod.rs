@@ -311,8 +311,8 @@ impl Scene {
             || self.lights.iter().zip(lights).any(|(a, b)| a.surface() != b.surface());
         self.lights = lights.to_vec();
         self.light_paths.resize(self.lights.len(), None);
-        self.light_culling = LightCulling::new(&self.lights);
         self.emitters = Emitters::new(&self.lights);
+        self.light_culling = LightCulling::new(&self.lights, self.emitters.firsts());
         self.placed_delta = placed_delta(&self.lights);
         if surfaces_moved {
             self.geometry = build_geometry(self.surfaces());
@@ -478,8 +478,8 @@ impl SceneBuilder {
             };
             placed.push((shape, material));
         }
-        let light_culling = LightCulling::new(&lights);
         let emitters = Emitters::new(&lights);
+        let light_culling = LightCulling::new(&lights, emitters.firsts());
         let placed_delta = placed_delta(&lights);
         let mut scene = Scene {
             settings,

@@ -359,10 +359,14 @@ impl PathTracer {
                     } else {
                         // A light that next-event estimation samples as a
                         // point (an approximated sphere) was counted there.
-                        let light_pdf =
-                            scene.emitter_pdf(index as usize, prev_p, ray.dir, (surface.p - prev_p).length());
+                        let light_pdf = light.pdf(prev_p, ray.dir, (surface.p - prev_p).length());
                         if light_pdf > 0.0 {
-                            let r_l = r_l * light_pdf;
+                            // Next-event estimation drew this light with its
+                            // chance within its emitter (an emitting mesh's
+                            // triangle). A triangle too small ever to be drawn
+                            // (chance 0 in f32) is found by this direction
+                            // alone, which then takes the whole weight.
+                            let r_l = r_l * (light_pdf * scene.emitter_chance(index as usize));
                             l += beta * le * power_heuristic(r_u, r_l, hero);
                         }
                     }
