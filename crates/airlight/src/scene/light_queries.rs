@@ -20,7 +20,8 @@ impl Scene {
     /// numbers `u` (see [`Light::sample`]: a volume light makes a third
     /// from these two); None when the light sends none there. Blockers are
     /// not tested: see [`Scene::unoccluded`]. Every light-sampling loop
-    /// goes through here or [`Scene::sample_light3`].
+    /// goes through here, [`Scene::sample_light3`] or
+    /// [`Scene::sample_emitter`].
     #[inline]
     pub fn sample_light(&self, index: usize, p: Vec3, u: Vec2) -> Option<LightSample> {
         self.lights[index].sample(p, u).filter(|s| s.weight != Rgb::ZERO)
