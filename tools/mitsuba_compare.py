@@ -8,8 +8,9 @@
 
 For each scene it translates the TOML file into a Mitsuba 3 scene (the
 subset of the schema the comparison scenes use: perspective camera, quad,
-sphere, box and plane objects, diffuse materials, point, spot, quad and
-sphere lights, a homogeneous medium filling space or a density grid with
+sphere, box, plane and mesh objects, diffuse materials, point, spot, quad and
+sphere lights, meshes with `emission` (Mitsuba's area emitter on the mesh,
+one-sided as Airlight's triangle lights), a homogeneous medium filling space or a density grid with
 a grey extinction), renders it with
 Mitsuba's `volpath` (or `path` in vacuum), renders it with `airlight render
 --integrator path` at the same size and sample count, and prints
@@ -187,7 +188,14 @@ def translate(path, spp, sampler="independent"):
             raise SystemExit(f"{path}: object type {t} does not translate")
         if t in ("sphere",) and any(k in o for k in ("translate", "rotate", "scale")):
             shape = {"type": "sphere", "to_world": object_transform(o) @ mi.ScalarTransform4f().translate(o["center"]) @ mi.ScalarTransform4f().scale(o["radius"])}
-        shape["bsdf"] = bsdf(o["material"])
+        if "emission" in o:
+            if t != "mesh":
+                raise SystemExit(f"{path}: only a mesh's emission translates")
+            # A light, not a reflecting surface (docs/scene-format.md).
+            shape["bsdf"] = black
+            shape["emitter"] = {"type": "area", "radiance": {"type": "rgb", "value": colour(o["emission"])}}
+        else:
+            shape["bsdf"] = bsdf(o["material"])
         shape.update(ext)
         scene[f"object{i}"] = shape
     for i, l in enumerate(s.get("lights", [])):
