@@ -8,10 +8,10 @@
 
 For each scene it translates the TOML file into a Mitsuba 3 scene (the
 subset of the schema the comparison scenes use: perspective camera, quad,
-sphere, box, plane and mesh objects, diffuse materials, point, spot, quad and
-sphere lights, meshes with `emission` (Mitsuba's area emitter on the mesh,
-one-sided as Airlight's triangle lights), a homogeneous medium filling space or a density grid with
-a grey extinction), renders it with
+sphere, box, plane and mesh objects, diffuse materials, point, spot, quad
+and sphere lights, meshes with `emission` (Mitsuba's area emitter on the
+mesh, one-sided as Airlight's triangle lights), a homogeneous medium
+filling space or a density grid with a grey extinction), renders it with
 Mitsuba's `volpath` (or `path` in vacuum), renders it with `airlight render
 --integrator path` at the same size and sample count, and prints
 `airlight compare` of the two, plus the noise floors: each renderer

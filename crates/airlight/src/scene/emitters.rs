@@ -70,9 +70,15 @@ impl Emitters {
     /// the cumulative table at it, so that it is exactly the measure of
     /// the numbers that [`Emitters::draw`] maps to it.
     pub fn chance(&self, index: usize) -> f32 {
+        self.share(index).1
+    }
+
+    /// Light `index`'s share of [0, 1) within its emitter: where it starts
+    /// and its width (the chance).
+    fn share(&self, index: usize) -> (f32, f32) {
         let first = self.first_of[index] as usize;
         let below = if index == first { 0.0 } else { self.cumulative[index - 1] };
-        self.cumulative[index] - below
+        (below, self.cumulative[index] - below)
     }
 
     /// Draws a light of the emitter that starts at `first` with `u.x`, and
@@ -87,8 +93,7 @@ impl Emitters {
         // The first light whose cumulative chance exceeds u.x.
         let k = table.partition_point(|&c| c <= u.x).min(table.len() - 1);
         let index = first + k;
-        let below = if k == 0 { 0.0 } else { table[k - 1] };
-        let chance = table[k] - below;
+        let (below, chance) = self.share(index);
         let stretched = ((u.x - below) / chance).clamp(0.0, ONE_BELOW);
         (index, chance, Vec2::new(stretched, u.y))
     }
