@@ -297,6 +297,12 @@ def main():
         help="render each renderer with this many seeds (at least 2) for its own error: the per-pixel variance "
         "across them; more seeds steady the equal-error ratio where a few pixels hold most of the error",
     )
+    p.add_argument(
+        "--airlight-arg",
+        action="append",
+        default=[],
+        help="an extra argument for Airlight's render command, repeatable (e.g. --airlight-arg=--adaptive)",
+    )
     p.add_argument("--out", default=os.path.join(tempfile.gettempdir(), "airlight-mitsuba"))
     args = p.parse_args()
     if args.seeds < 2:
@@ -324,7 +330,7 @@ def main():
         integrator = "direct" if integrator == "direct" else "path"
         ours = os.path.join(args.out, f"{name}.airlight.exr")
         others = [os.path.join(args.out, f"{name}.airlight-seed{k}.exr") for k in range(1, args.seeds)]
-        common = ["render", path, "--integrator", integrator, "--spp", str(args.spp)]
+        common = ["render", path, "--integrator", integrator, "--spp", str(args.spp), *args.airlight_arg]
         # The same seed gives the same image, so each run rewrites the same file.
         airlight_seconds, airlight_command = min(
             render_seconds(airlight(*common, "-o", ours)[1]) for _ in range(max(1, args.repeat))

@@ -79,6 +79,11 @@ pub struct RenderArgs {
     /// Samples per pixel.
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=MAX_SPP as i64))]
     spp: Option<u32>,
+    /// Spread the samples over the pixels by their noise: spp a pixel on
+    /// average, more where a pilot pass found the image noisy (the edges of
+    /// lights in view), fewer where it is smooth. As `[render] adaptive`.
+    #[arg(long)]
+    adaptive: bool,
     /// March samples per ray.
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=MAX_STEPS as i64))]
     steps: Option<u32>,
@@ -213,6 +218,12 @@ pub fn render(args: RenderArgs) -> Result<(), String> {
     let progressive =
         args.progressive || args.target_error.is_some() || args.variance.is_some() || aovs.contains(&Aov::Variance);
     crate::aovs::check(&aovs, &outputs, plan.partial, desc.kind)?;
+    if scene.settings().adaptive && (plan.partial || progressive) {
+        return Err("adaptive sampling (--adaptive or `[render] adaptive`) renders in one go, its counts set by a \
+                    pilot pass: it does not go with --shard, --tile, --progressive, --target-error, --variance or \
+                    --aov variance"
+            .into());
+    }
     let (files, variance) = (scene.files(), args.variance.as_deref());
     crate::outputs::check_render(args.scene.as_deref(), files, &outputs, variance, args.frames)?;
     // As the frames below are rendered: a part first, then passes.
@@ -334,6 +345,9 @@ fn configure(args: &RenderArgs) -> Result<SceneFile, String> {
     }
     if let Some(v) = args.seed {
         s.seed = v;
+    }
+    if args.adaptive {
+        s.adaptive = true;
     }
     s.validate()?;
     let d = &mut file.integrator;

@@ -1,5 +1,5 @@
-//! `airlight render` with --frames (light animation), --target-error and
-//! --variance.
+//! `airlight render` with --frames (light animation), --target-error,
+//! --variance and --adaptive.
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -134,4 +134,34 @@ fn an_interrupted_progressive_render_resumes_to_the_uninterrupted_image() {
     let refused = airlight(d, &[&args[..], &["--progressive", "--resume", "-o", "y.exr"]].concat());
     assert!(!refused.status.success());
     assert!(String::from_utf8_lossy(&refused.stderr).contains("not an Airlight partial render"));
+}
+
+#[test]
+fn adaptive_sampling_renders_in_one_go_and_refuses_passes_and_parts() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let cornell = scene("compare_cornell.toml");
+    let small = ["--width", "24", "--height", "16", "--spp", "16"];
+    let out = airlight(d, &[&["render", &cornell, "--adaptive", "-o", "a.exr", "--quiet"][..], &small].concat());
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    // The same counts and samples whatever the thread count.
+    let out = airlight(
+        d,
+        &[&["render", &cornell, "--adaptive", "--threads", "1", "-o", "b.exr", "--quiet"][..], &small].concat(),
+    );
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert_eq!(std::fs::read(d.join("a.exr")).unwrap(), std::fs::read(d.join("b.exr")).unwrap());
+    for extra in [
+        &["--progressive"][..],
+        &["--target-error", "0.1"],
+        &["--variance", "v.exr"],
+        &["--shard", "0/2"],
+        &["--tile", "0/2"],
+    ] {
+        let args = [&["render", &cornell, "--adaptive", "-o", "p.exr"][..], &small, extra].concat();
+        let out = airlight(d, &args);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success() && stderr.contains("renders in one go"), "{extra:?}: {stderr}");
+    }
+    assert_eq!(names(d), ["a.exr", "b.exr"], "nothing else written");
 }

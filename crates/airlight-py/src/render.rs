@@ -163,6 +163,10 @@ fn work(job: &Job, state: &State) -> Result<Output, Failure> {
         let acc = pool.install(|| accumulate(&shared.scene, integrator, job.samples.clone(), rows, &observer));
         let variance = flat(acc.pixels().iter().map(|p| p.variance_of_mean().as_vec3()));
         (flat(acc.pixels().iter().map(PixelSum::mean)), Some(variance))
+    } else if job.settings.adaptive {
+        // Every sample of the render (a shard is refused): spread by noise.
+        let image = pool.install(|| airlight::render(&shared.scene, integrator, &observer));
+        (flat(image.pixels.into_iter()), None)
     } else {
         // (At most the scene's spp, a u32.)
         let (first, count) = (job.samples.start, (job.samples.end - job.samples.start) as u32);

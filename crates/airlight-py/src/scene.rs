@@ -439,6 +439,12 @@ impl PyScene {
                 ));
             }
             let variance = aovs.contains(&Aov::Variance);
+            if settings.adaptive && (shard.is_some() || variance) {
+                return Err(PyValueError::new_err(
+                    "adaptive sampling renders in one go, its counts set by a pilot pass: it does not go with \
+                     shard or the variance AOV, as `airlight render --adaptive` refuses --shard and --variance",
+                ));
+            }
             let surface = aovs.iter().any(|a| matches!(a, Aov::Albedo | Aov::Normal | Aov::Depth));
             // As the CLI does before it renders: an image too large for
             // memory is refused, a scene that can only be black is warned of.

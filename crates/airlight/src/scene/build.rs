@@ -182,6 +182,9 @@ impl Checker<'_> {
         if let Some(c) = r.cull_lights {
             s.cull_lights = c;
         }
+        if let Some(a) = r.adaptive {
+            s.adaptive = a;
+        }
         if let Some(f) = &r.filter {
             s.filter = desc::parse_name(f, "render.filter").map_err(located)?;
         }

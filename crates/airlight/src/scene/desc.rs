@@ -63,6 +63,7 @@ pub struct RenderDesc {
     pub tonemap: Option<Spanned<String>>,
     pub jitter: Option<bool>,
     pub cull_lights: Option<bool>,
+    pub adaptive: Option<bool>,
     pub filter: Option<Spanned<String>>,
     /// Radiosity: patch side length in world units (default: 1/32 of the
     /// largest extent of the bounded geometry).

@@ -68,6 +68,9 @@ pub struct RenderSettings {
     pub filter: PixelFilter,
     /// Skip lights whose range ends before a point (finite-range falloffs).
     pub cull_lights: bool,
+    /// Spread the samples over the pixels by their noise, `spp` a pixel on
+    /// average (`render::adaptive`), rather than `spp` in every pixel.
+    pub adaptive: bool,
 }
 
 /// Largest image side.
@@ -132,6 +135,7 @@ impl Default for RenderSettings {
             tonemap: Tonemap::Clamp,
             filter: PixelFilter::Box,
             cull_lights: true,
+            adaptive: false,
         }
     }
 }

@@ -17,6 +17,8 @@ use rayon::prelude::*;
 use std::ops::Range;
 use std::sync::atomic::{AtomicBool, Ordering};
 
+pub mod adaptive;
+
 const TILE: u32 = 16;
 
 /// Side of the square blocks of pixels whose samples are traced together
@@ -63,8 +65,13 @@ impl RenderObserver<'_> {
 
 /// Renders the scene's `spp` samples of every pixel with `integrator`: each
 /// pixel the mean of its samples (box filtered, unless the scene asks for
-/// point sampling).
+/// point sampling). With `adaptive` set in the scene's settings, the same
+/// number of samples in all, spread over the pixels by their noise
+/// ([`adaptive`]).
 pub fn render(scene: &Scene, integrator: &dyn Integrator, observer: &RenderObserver) -> Image {
+    if scene.settings().adaptive {
+        return adaptive::render_adaptive(scene, integrator, observer);
+    }
     render_samples(scene, integrator, 0, scene.settings().spp, observer)
 }
 
@@ -87,19 +94,34 @@ pub fn render_samples(
     count: u32,
     observer: &RenderObserver,
 ) -> Image {
-    let s = scene.settings();
     let samples = first..first + count as u64;
+    render_pixel_samples(scene, integrator, scene.settings().seed, |_, _| samples.clone(), observer)
+}
+
+/// Renders samples `samples_of(x, y)` of each pixel (x, y), drawn with
+/// `seed`: each pixel the mean of its samples (black if it has none).
+/// [`render_samples`] gives every pixel the same range; adaptive sampling
+/// gives each its own count.
+pub(crate) fn render_pixel_samples(
+    scene: &Scene,
+    integrator: &dyn Integrator,
+    seed: u64,
+    samples_of: impl Fn(u32, u32) -> Range<u64> + Sync,
+    observer: &RenderObserver,
+) -> Image {
+    let s = scene.settings();
     let mut image = Image::new(s.width, s.height);
-    for_each_tile(&mut image.pixels, s.width, 0, count as u64, observer, |origin, means| {
+    for_each_tile(&mut image.pixels, s.width, 0, observer, |origin, means| {
         let tile_width = means.first().map_or(0, |row| row.len());
         let mut sums = vec![PixelTotal::default(); tile_width * means.len()];
         let mut sum_rows: TileRows<PixelTotal> = sums.chunks_mut(tile_width.max(1)).collect();
-        tile_sums(scene, integrator, origin, &mut sum_rows, samples.clone());
+        let done = tile_sums(scene, integrator, origin, &mut sum_rows, seed, &samples_of);
         for (row, sums) in means.iter_mut().zip(&sum_rows) {
             for (mean, sum) in row.iter_mut().zip(sums.iter()) {
                 *mean = sum.mean();
             }
         }
+        done
     });
     image
 }
@@ -137,34 +159,49 @@ pub fn accumulate_into(
         (scene.settings().width, scene.settings().height),
         "an accumulator of the scene's image"
     );
-    let first_row = acc.rows().start;
-    let per_pixel = samples.end.saturating_sub(samples.start);
+    accumulate_pixel_samples(scene, integrator, scene.settings().seed, |_, _| samples.clone(), acc, observer);
+}
+
+/// Adds samples `samples_of(x, y)` of each pixel (x, y) that `acc` holds,
+/// drawn with `seed`, into it (see [`accumulate_into`]).
+pub(crate) fn accumulate_pixel_samples(
+    scene: &Scene,
+    integrator: &dyn Integrator,
+    seed: u64,
+    samples_of: impl Fn(u32, u32) -> Range<u64> + Sync,
+    acc: &mut Accumulator,
+    observer: &RenderObserver,
+) {
+    let (width, first_row) = (acc.size().0, acc.rows().start);
     // Each tile gets its rows of the accumulator's pixels (disjoint slices)
     // and adds its samples there: no copy, no second image-sized buffer.
-    for_each_tile(acc.pixels_mut(), width, first_row, per_pixel, observer, |origin, tile| {
-        tile_sums(scene, integrator, origin, tile, samples.clone());
+    for_each_tile(acc.pixels_mut(), width, first_row, observer, |origin, tile| {
+        tile_sums(scene, integrator, origin, tile, seed, &samples_of)
     });
 }
 
 /// Runs `work(origin, rows)` on every tile of `pixels` ([`tiles`]) over the
 /// threads, each tile once; tiles not started when the observer's cancel
 /// flag is set are skipped. Each finished tile is reported to the observer
-/// as its pixels times `per_pixel` samples.
+/// with the number of samples its `work` returns.
 fn for_each_tile<T: Send>(
     pixels: &mut [T],
     width: u32,
     first_row: u32,
-    per_pixel: u64,
     observer: &RenderObserver,
-    work: impl Fn((u32, u32), &mut TileRows<T>) + Sync,
+    work: impl Fn((u32, u32), &mut TileRows<T>) -> u64 + Sync,
 ) {
-    tiles(pixels, width, first_row).into_par_iter().for_each(|(origin, mut tile)| {
+    // Each tile its own piece of work to steal (`with_max_len(1)`): rayon
+    // otherwise hands a thread runs of tiles that it works through alone,
+    // and where tiles' costs differ (adaptive sampling's counts) one thread
+    // ended with a run of costly tiles while the other waited.
+    tiles(pixels, width, first_row).into_par_iter().with_max_len(1).for_each(|(origin, mut tile)| {
         if observer.cancelled() {
             return;
         }
-        work(origin, &mut tile);
+        let samples = work(origin, &mut tile);
         if let Some(progress) = observer.progress {
-            progress(tile.iter().map(|row| row.len() as u64).sum::<u64>() * per_pixel);
+            progress(samples);
         }
     });
 }
@@ -192,44 +229,73 @@ fn tiles<T>(pixels: &mut [T], width: u32, first_row: u32) -> Vec<((u32, u32), Ti
 /// A tile's rows of pixels (by default its pixel sums), top row first.
 type TileRows<'a, T = PixelSum> = Vec<&'a mut [T]>;
 
-/// Adds the samples `samples` of the pixels of the tile whose top-left
-/// pixel is (x0, y0) into `tile`, its rows of pixel sums. The samples of
+/// Adds the samples `samples_of(x, y)` of each pixel (x, y) of the tile
+/// whose top-left pixel is (x0, y0), drawn with `seed`, into `tile`, its
+/// rows of pixel sums; returns how many samples that was. The samples of
 /// each [`BLOCK`]×[`BLOCK`] block of pixels go to the integrator together,
-/// sample number by sample number, in [`BLOCK_ORDER`]; each pixel's sum is
-/// [`pixel_sum`]'s, bit for bit (the same samples, added in the same order).
+/// [`BLOCK_ORDER`]'s count at a time: sample number by sample number, each
+/// number with the pixels in [`BLOCK_ORDER`] whose range holds it. (Where
+/// the pixels' counts differ, as under adaptive sampling, a batch so
+/// takes the next numbers of the pixels that still have samples, rather
+/// than shrinking to them: a pixel's own rays are the most alike.) Each
+/// pixel's sum is [`pixel_sum`]'s, bit for bit: the same samples, and the
+/// sums are exact, so the order they are added in does not matter.
 fn tile_sums(
     scene: &Scene,
     integrator: &dyn Integrator,
     (x0, y0): (u32, u32),
     tile: &mut [&mut [impl AddSample]],
-    samples: Range<u64>,
-) {
+    seed: u64,
+    samples_of: impl Fn(u32, u32) -> Range<u64>,
+) -> u64 {
     let s = scene.settings();
     let (x1, y1) = (x0 + tile.first().map_or(0, |row| row.len() as u32), y0 + tile.len() as u32);
     let film = scene.camera().rays(s.width, s.height);
     let n = BLOCK_ORDER.len();
+    let mut block = Vec::with_capacity(n);
     let (mut pixels, mut rays, mut samplers) = (Vec::with_capacity(n), Vec::with_capacity(n), Vec::with_capacity(n));
     let mut radiance = vec![Rgb::ZERO; n];
+    let mut done = 0;
+    let mut trace = |pixels: &mut Vec<(u32, u32)>, rays: &mut Vec<_>, samplers: &mut Vec<Sampler>| {
+        let radiance = &mut radiance[..pixels.len()];
+        integrator.radiance_batch(scene, rays, samplers, radiance);
+        for (&(x, y), r) in pixels.iter().zip(radiance.iter()) {
+            tile[(y - y0) as usize][(x - x0) as usize].add(*r);
+        }
+        done += pixels.len() as u64;
+        pixels.clear();
+        rays.clear();
+        samplers.clear();
+    };
     for by in (y0..y1).step_by(BLOCK as usize) {
         for bx in (x0..x1).step_by(BLOCK as usize) {
-            pixels.clear();
-            pixels.extend(BLOCK_ORDER.iter().map(|&(dx, dy)| (bx + dx, by + dy)).filter(|&(x, y)| x < x1 && y < y1));
-            for i in samples.clone() {
-                rays.clear();
-                samplers.clear();
-                for &(x, y) in &pixels {
-                    let mut sampler = Sampler::for_pixel(s.seed, y as u64 * s.width as u64 + x as u64, i);
-                    rays.push(film_ray(&film, s.filter, integrator.stratified(), x, y, &mut sampler));
+            block.clear();
+            block.extend(
+                BLOCK_ORDER
+                    .iter()
+                    .map(|&(dx, dy)| (bx + dx, by + dy))
+                    .filter(|&(x, y)| x < x1 && y < y1)
+                    .map(|(x, y)| (x, y, samples_of(x, y))),
+            );
+            let first = block.iter().map(|(.., r)| r.start).min().unwrap_or(0);
+            let end = block.iter().map(|(.., r)| r.end).max().unwrap_or(0);
+            for i in first..end {
+                for (x, y, _) in block.iter().filter(|(.., r)| r.contains(&i)) {
+                    let mut sampler = Sampler::for_pixel(seed, *y as u64 * s.width as u64 + *x as u64, i);
+                    rays.push(film_ray(&film, s.filter, integrator.stratified(), *x, *y, &mut sampler));
                     samplers.push(sampler);
+                    pixels.push((*x, *y));
+                    if pixels.len() == n {
+                        trace(&mut pixels, &mut rays, &mut samplers);
+                    }
                 }
-                let radiance = &mut radiance[..pixels.len()];
-                integrator.radiance_batch(scene, &rays, &mut samplers, radiance);
-                for (&(x, y), r) in pixels.iter().zip(radiance.iter()) {
-                    tile[(y - y0) as usize][(x - x0) as usize].add(*r);
-                }
+            }
+            if !pixels.is_empty() {
+                trace(&mut pixels, &mut rays, &mut samplers);
             }
         }
     }
+    done
 }
 
 /// The samples `samples` of pixel (x, y), summed.
