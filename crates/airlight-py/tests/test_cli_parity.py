@@ -106,3 +106,21 @@ def test_aovs_equal_the_layers_the_cli_writes(cli, tmp_path, scene):
         got = out[name] if out[name].ndim == 3 else out[name][..., None]
         assert np.array_equal(got, expected), name
     assert np.isfinite(out["depth"]).any() and out["albedo"].max() > 0
+
+
+def test_an_adaptive_scene_renders_as_the_cli_and_refuses_shards(cli, tmp_path):
+    # `[render] adaptive = true` in the scene: the pilot and the counts are
+    # the CLI's `--adaptive`, so the pixels are too.
+    text = (SCENES / "compare_cornell.toml").read_text().replace("[render]\n", "[render]\nadaptive = true\n", 1)
+    path = tmp_path / "adaptive.toml"
+    path.write_text(text)
+    out = tmp_path / "cli.exr"
+    cli("render", SCENES / "compare_cornell.toml", "--adaptive", "--spp", 16, "-o", out,
+        "--width", SIZE["width"], "--height", SIZE["height"], "--quiet")
+    scene = airlight.load(path)
+    image = scene.render(**SIZE, spp=16)
+    assert np.array_equal(image, read_exr(out)), airlight.compare(image, read_exr(out))
+    uniform = airlight.load(SCENES / "compare_cornell.toml").render(**SIZE, spp=16)
+    assert not np.array_equal(image, uniform)
+    with pytest.raises(ValueError, match="adaptive sampling renders in one go"):
+        scene.render(**SIZE, spp=16, shard=(0, 2))
