@@ -191,7 +191,12 @@ fn gi(args: GiArgs) -> Result<(), String> {
     s.validate()?;
     if let Some(dir) = &args.output_dir {
         outputs::check_folder("--output-dir", dir)?;
-        preflight::render_memory(&scene, airlight::memory::RenderFilm::Image)?;
+        let film = if scene.settings().adaptive {
+            airlight::memory::RenderFilm::Adaptive
+        } else {
+            airlight::memory::RenderFilm::Image
+        };
+        preflight::render_memory(&scene, film)?;
     }
     preflight::warn_if_dark(&scene, true);
     let pool = rayon::ThreadPoolBuilder::new()

@@ -230,6 +230,7 @@ pub fn render(args: RenderArgs) -> Result<(), String> {
     let film = match (plan.partial, progressive) {
         (true, _) => RenderFilm::Sums,
         (false, true) => RenderFilm::Progressive { cancellable: false },
+        (false, false) if scene.settings().adaptive => RenderFilm::Adaptive,
         (false, false) => RenderFilm::Image,
     };
     crate::preflight::render_memory(&scene, film)?;

@@ -450,8 +450,15 @@ impl PyScene {
             // memory is refused, a scene that can only be black is warned of.
             let pixels = settings.width as u64 * settings.height as u64;
             let what = format!("a {}×{} render", settings.width, settings.height);
-            // A variance keeps every pixel's sums to the end, as passes do.
-            let film = if variance { RenderFilm::Progressive { cancellable: false } } else { RenderFilm::Image };
+            // A variance keeps every pixel's sums to the end, as passes do;
+            // adaptive sampling keeps them through its pilot.
+            let film = if variance {
+                RenderFilm::Progressive { cancellable: false }
+            } else if settings.adaptive {
+                RenderFilm::Adaptive
+            } else {
+                RenderFilm::Image
+            };
             airlight::memory::check(what, airlight::memory::render_bytes(pixels, film))
                 .map_err(|e| PyMemoryError::new_err(format!("{e}: make the image smaller (width=, height=)")))?;
             let sees_medium = desc.kind != IntegratorKind::Direct;

@@ -96,6 +96,12 @@ pub enum RenderFilm {
     /// pixel in all). A pass that may be `cancellable` (the study's) adds
     /// into sums of its own first, so that a cancelled pass adds nothing.
     Progressive { cancellable: bool },
+    /// Adaptive sampling (`render::adaptive`): at the pilot's end its
+    /// accumulator, each pixel's noise twice (as measured, and raised to
+    /// its neighbours'; f64 each) and its count of samples; then the image
+    /// and its encoded file, as [`RenderFilm::Image`] (measured at 2048²:
+    /// 132 bytes a pixel in all, the Cornell box).
+    Adaptive,
 }
 
 /// Bytes a render of `pixels` pixels holds at its peak: the sums and images
@@ -109,6 +115,7 @@ pub fn render_bytes(pixels: u64, film: RenderFilm) -> u64 {
         RenderFilm::Sums => sums + 2 * image,
         RenderFilm::Progressive { cancellable: false } => sums + 4 * image,
         RenderFilm::Progressive { cancellable: true } => 2 * sums + 4 * image,
+        RenderFilm::Adaptive => sums + 2 * 8 + 4 + 2 * image,
     };
     pixels.saturating_mul(per_pixel)
 }
