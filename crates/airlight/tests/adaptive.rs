@@ -1,9 +1,10 @@
-//! Adaptive sampling (`render::adaptive`): unbiased against closed forms
-//! and against uniform renders of many more samples, lower error than a
-//! uniform render of the same budget where the noise lies in a few pixels,
-//! the budget kept, and the image independent of the thread count.
+//! Adaptive sampling (`render::adaptive`): unbiased against uniform renders
+//! of many more samples (and against Lambert's closed form in
+//! tests/direct.rs), lower error than a uniform render of the same budget
+//! where the noise lies in a few pixels, the budget kept, and the image
+//! independent of the thread count.
 
-use airlight::integrator::{Direct, Integrator, PathOptions, PathTracer};
+use airlight::integrator::{Direct, PathOptions, PathTracer};
 use airlight::prelude::*;
 use airlight::render::adaptive::{pilot_samples, plan};
 use airlight::render::render;
@@ -84,43 +85,6 @@ fn the_pilot_gives_the_edges_more_samples_and_the_budget_is_kept() {
     };
     render(&scene, &Direct, &RenderObserver { progress: Some(&count), cancel: None });
     assert_eq!(traced.load(Ordering::Relaxed), pixels as u64 * 64);
-}
-
-/// Irradiance at the origin (normal +y) from a uniformly emitting
-/// parallelogram, by Lambert's closed form for polygons.
-fn lambert_irradiance(corner: Vec3, u: Vec3, v: Vec3, radiance: f64) -> f64 {
-    let verts = [corner, corner + u, corner + u + v, corner + v].map(|p| p.as_dvec3().normalize());
-    let mut sum = 0.0;
-    for i in 0..4 {
-        let (a, b) = (verts[i], verts[(i + 1) % 4]);
-        sum += a.dot(b).clamp(-1.0, 1.0).acos() * a.cross(b).normalize().y;
-    }
-    0.5 * radiance * sum.abs()
-}
-
-#[test]
-fn an_adaptive_render_of_a_lit_floor_matches_lambert() {
-    // A floor point under a quad light, as tests/direct.rs renders it
-    // uniformly: the adaptive render's pixels keep the closed form.
-    let (corner, u, v) = (vec3(-0.3, 1.0, -0.4), vec3(1.0, 0.0, 0.0), vec3(0.0, 0.0, 1.2));
-    let expected = lambert_irradiance(corner, u, v, 1.0) / std::f64::consts::PI;
-    let scene = SceneBuilder::new()
-        .size(4, 4)
-        .with_settings(|s| {
-            s.spp = 4096;
-            s.adaptive = true;
-        })
-        .camera(Camera::look_at(vec3(0.0, 0.5, 0.0), Vec3::ZERO, Vec3::Z, 0.5))
-        .material("white", Material::diffuse(Rgb::ONE))
-        .object(Shape::plane(Vec3::ZERO, Vec3::Y), "white")
-        .light(Light::quad(corner, u, v, Rgb::ONE))
-        .build()
-        .unwrap();
-    let path = PathTracer::new(PathOptions { max_depth: 1, ..PathOptions::default() });
-    for (name, integrator) in [("direct", &Direct as &dyn Integrator), ("path", &path)] {
-        let got = render(&scene, integrator, &RenderObserver::none()).mean().x as f64;
-        assert!((got / expected - 1.0).abs() < 0.01, "{name}: {got} vs {expected}");
-    }
 }
 
 #[test]

@@ -158,6 +158,31 @@ fn quad_and_mesh_lights_on_a_floor_through_the_integrators_match_lambert() {
 }
 
 #[test]
+fn an_adaptive_render_of_a_lit_floor_matches_lambert() {
+    // The floor point of the test above, rendered with adaptive sampling
+    // (render::adaptive): its pixels keep the closed form.
+    let (corner, u, v) = (vec3(-0.3, 1.0, -0.4), vec3(1.0, 0.0, 0.0), vec3(0.0, 0.0, 1.2));
+    let expected = lambert_irradiance(corner, u, v, 1.0) / std::f64::consts::PI;
+    let scene = SceneBuilder::new()
+        .size(4, 4)
+        .with_settings(|s| {
+            s.spp = 4096;
+            s.adaptive = true;
+        })
+        .camera(Camera::look_at(vec3(0.0, 0.5, 0.0), Vec3::ZERO, Vec3::Z, 0.5))
+        .material("white", Material::diffuse(Rgb::ONE))
+        .object(Shape::plane(Vec3::ZERO, Vec3::Y), "white")
+        .light(Light::quad(corner, u, v, Rgb::ONE))
+        .build()
+        .unwrap();
+    let path = PathTracer::new(PathOptions { max_depth: 1, ..PathOptions::default() });
+    for (name, integrator) in [("direct", &Direct as &dyn Integrator), ("path", &path)] {
+        let got = render(&scene, integrator, &RenderObserver::none()).mean().x as f64;
+        assert!((got / expected - 1.0).abs() < 0.01, "{name}: {got} vs {expected}");
+    }
+}
+
+#[test]
 fn surfaces_see_an_area_light_at_a_slant_but_not_through_a_blocker() {
     // Floor points lifted off the floor see points of a ceiling quad light
     // (which is geometry too) from every angle up to grazing; a shadow ray
