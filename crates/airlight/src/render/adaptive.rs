@@ -26,7 +26,8 @@
 //! each pixel's mean is an unbiased estimate whatever its count; averaging
 //! the pilot in too would not be (a pilot that saw a bright sample asks for
 //! more samples, which then dilute it). The pilot costs its share of the
-//! budget (1/16) without entering the image.
+//! budget (a sixteenth, or 2 samples a pixel below 32) without entering
+//! the image.
 
 use super::{RenderObserver, accumulate_pixel_samples, render_pixel_samples};
 use crate::film::{Accumulator, Image};
