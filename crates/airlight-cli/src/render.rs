@@ -224,6 +224,13 @@ pub fn render(args: RenderArgs) -> Result<(), String> {
                     --aov variance"
             .into());
     }
+    if scene.settings().adaptive && aovs.contains(&Aov::Inscatter) {
+        // The layer is drawn with a uniform render's samples, so the image
+        // minus it would no longer be the surfaces' light sample for sample.
+        return Err("--aov inscatter is drawn with the samples of a uniform render: it does not go with adaptive \
+                    sampling (--adaptive or `[render] adaptive`)"
+            .into());
+    }
     let (files, variance) = (scene.files(), args.variance.as_deref());
     crate::outputs::check_render(args.scene.as_deref(), files, &outputs, variance, args.frames)?;
     // As the frames below are rendered: a part first, then passes.

@@ -163,5 +163,10 @@ fn adaptive_sampling_renders_in_one_go_and_refuses_passes_and_parts() {
         let stderr = String::from_utf8_lossy(&out.stderr);
         assert!(!out.status.success() && stderr.contains("renders in one go"), "{extra:?}: {stderr}");
     }
+    let fog = ["--integrator", "raymarch", "--aov", "inscatter"];
+    let args = [&["render", &cornell, "--adaptive", "-o", "p.exr"][..], &small, &fog].concat();
+    let out = airlight(d, &args);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success() && stderr.contains("does not go with adaptive"), "{stderr}");
     assert_eq!(names(d), ["a.exr", "b.exr"], "nothing else written");
 }
