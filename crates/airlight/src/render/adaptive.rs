@@ -127,10 +127,11 @@ pub fn allocate(sigma: &[f64], per_pixel: u32) -> Vec<u32> {
     // Water-filling: cap the pixels whose share would pass the cap, and
     // share what is left among the others, until none passes it.
     let mut capped = vec![false; n];
-    loop {
+    // The uncapped pixels' sum of sigma, kept from the last round.
+    let free = loop {
         let free: f64 = sigma.iter().zip(&capped).filter(|&(_, &c)| !c).map(|(&s, _)| s).sum();
         if free <= 0.0 {
-            break;
+            break free;
         }
         let scale = to_spread / free;
         let mut newly = 0;
@@ -141,11 +142,10 @@ pub fn allocate(sigma: &[f64], per_pixel: u32) -> Vec<u32> {
             }
         }
         if newly == 0 {
-            break;
+            break free;
         }
         to_spread -= newly as f64 * headroom;
-    }
-    let free: f64 = sigma.iter().zip(&capped).filter(|&(_, &c)| !c).map(|(&s, _)| s).sum();
+    };
     let uncapped = capped.iter().filter(|&&c| !c).count() as f64;
     // Whole samples by rounding the running total, so that the counts sum
     // to the budget exactly.
