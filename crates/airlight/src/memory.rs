@@ -96,11 +96,12 @@ pub enum RenderFilm {
     /// pixel in all). A pass that may be `cancellable` (the study's) adds
     /// into sums of its own first, so that a cancelled pass adds nothing.
     Progressive { cancellable: bool },
-    /// Adaptive sampling (`render::adaptive`): at the pilot's end its
-    /// accumulator, each pixel's noise twice (as measured, and raised to
-    /// its neighbours'; f64 each) and its count of samples; then the image
-    /// and its encoded file, as [`RenderFilm::Image`] (measured at 2048²:
-    /// 132 bytes a pixel in all, the Cornell box).
+    /// Adaptive sampling (`render::adaptive`): the accumulator, which
+    /// holds the pilot and then every sample; while planning, each pixel's
+    /// noise twice (as measured, and its neighbours' largest; f64 each)
+    /// and its count of samples; then the image and its encoded file, as
+    /// [`RenderFilm::Image`] (measured at 2048²: 135 bytes a pixel in
+    /// all, the Cornell box).
     Adaptive,
 }
 

@@ -1,12 +1,13 @@
 //! Adaptive sampling (`render::adaptive`): unbiased against uniform renders
 //! of many more samples (and against Lambert's closed form in
 //! tests/direct.rs), lower error than a uniform render of the same budget
-//! where the noise lies in a few pixels, the budget kept, and the image
-//! independent of the thread count.
+//! where the noise lies in a few pixels, the budget kept, a pixel's count
+//! independent of its own samples, and the image independent of the
+//! thread count.
 
 use airlight::integrator::{Direct, PathOptions, PathTracer};
 use airlight::prelude::*;
-use airlight::render::adaptive::{pilot_samples, plan};
+use airlight::render::adaptive::{pilot, pilot_samples, plan};
 use airlight::render::render;
 use std::sync::atomic::{AtomicU64, Ordering};
 
@@ -70,21 +71,56 @@ fn the_same_budget_spread_by_noise_lowers_the_error_without_bias() {
 #[test]
 fn the_pilot_gives_the_edges_more_samples_and_the_budget_is_kept() {
     let scene = light_in_view(64, true);
-    let counts = plan(&scene, &Direct, &RenderObserver::none());
-    let pixels = (24 * 16) as u32;
-    assert_eq!(counts.iter().sum::<u32>(), pixels * (64 - pilot_samples(64)));
-    // Flat pixels (every pilot sample the same) keep the floor, a quarter
-    // of the second stage's mean; the edges take the rest.
+    let pilot_sums = pilot(&scene, &Direct, &RenderObserver::none());
+    let pixels = 24 * 16;
+    let more = 64 - pilot_samples(64);
+    let counts = plan(&pilot_sums, more, scene.settings().seed);
+    let planned: u32 = counts.iter().sum();
+    // On average the budget; the random rounding of 384 shares is within
+    // a few samples of it.
+    assert!(planned.abs_diff(pixels * more) < 40, "{planned} against {}", pixels * more);
+    // Flat pixels (every pilot sample the same, around them too) keep the
+    // floor, a quarter of the second stage's mean; the edges take the rest.
     let (least, most) = (*counts.iter().min().unwrap(), *counts.iter().max().unwrap());
-    assert_eq!(least, (64 - pilot_samples(64)) / 4);
+    assert_eq!(least, more / 4);
     assert!(most > 4 * 64, "the most samples a pixel took: {most}");
-    // The whole render, pilot and all, traces the budget's samples exactly.
+    // The whole render traces the pilot's samples and the planned ones.
     let traced = AtomicU64::new(0);
     let count = |n: u64| {
         traced.fetch_add(n, Ordering::Relaxed);
     };
     render(&scene, &Direct, &RenderObserver { progress: Some(&count), cancel: None });
-    assert_eq!(traced.load(Ordering::Relaxed), pixels as u64 * 64);
+    assert_eq!(traced.load(Ordering::Relaxed), (pixels * pilot_samples(64) + planned) as u64);
+}
+
+#[test]
+fn a_pixels_count_follows_its_neighbours_noise_not_its_own() {
+    // The pilot's samples are in the image, so a pixel's count must not
+    // depend on them: the image would be biased toward whatever asked for
+    // more samples.
+    let scene = light_in_view(64, true);
+    let quiet = pilot(&scene, &Direct, &RenderObserver::none());
+    let (x, y) = (2, 2); // in the black background, its neighbours too
+    let mut loud = quiet.clone();
+    let pixel = loud.pixel_mut(x, y).unwrap();
+    for k in 0..4 {
+        pixel.add(Rgb::splat(if k % 2 == 0 { 0.0 } else { 50.0 }));
+    }
+    let (more, seed, at) = (64 - pilot_samples(64), scene.settings().seed, |x: u32, y: u32| (y * 24 + x) as usize);
+    let (before, after) = (plan(&quiet, more, seed), plan(&loud, more, seed));
+    assert_eq!(before[at(x, y)], more / 4, "a flat pixel takes the floor");
+    // Its own count moves only through the image-wide scaling of shares
+    // (the image's noise rose): by at most the one sample of rounding.
+    assert!(after[at(x, y)].abs_diff(before[at(x, y)]) <= 1, "{} → {}", before[at(x, y)], after[at(x, y)]);
+    // Its eight neighbours' counts rise.
+    for (nx, ny) in [(1, 1), (2, 1), (3, 1), (1, 2), (3, 2), (1, 3), (2, 3), (3, 3)] {
+        assert!(
+            after[at(nx, ny)] > 2 * before[at(nx, ny)],
+            "({nx}, {ny}): {} → {}",
+            before[at(nx, ny)],
+            after[at(nx, ny)]
+        );
+    }
 }
 
 #[test]
