@@ -33,7 +33,8 @@
 //! pixel on an edge has neighbours along the edge.
 //!
 //! The counts keep the budget on average; the rounding makes the total
-//! differ from W·H·`spp` by a few samples (about √(W·H)/4).
+//! differ from W·H·`spp` by a few samples (a standard deviation of at
+//! most √(W·H)/2: each pixel's rounding varies by at most ¼ sample²).
 //!
 //! An earlier version drew the pilot with a seed of its own and left it out
 //! of the image, a sixteenth of the budget spent on measuring alone: the
