@@ -79,7 +79,7 @@ impl BoxLanes {
     /// Calls `found(t, id)` for every box the ray `o + t·d` meets at
     /// 0 < t < tmax, with its distance, in the order given: the caller
     /// keeps the nearest (and breaks its ties).
-    #[inline]
+    #[inline(always)]
     pub fn for_each_hit(&self, o: Vec3, d: Vec3, tmax: f32, mut found: impl FnMut(f32, u32)) {
         for g in &self.groups {
             let t = distances(g, o, d, tmax);
@@ -92,9 +92,20 @@ impl BoxLanes {
     }
 
     /// Whether any box meets the ray at 0 < t < tmax.
-    #[inline]
+    #[inline(always)]
     pub fn any_hit(&self, o: Vec3, d: Vec3, tmax: f32) -> bool {
-        self.groups.iter().any(|g| distances(g, o, d, tmax).iter().any(|&t| t < tmax))
+        // Plain loops, no closures: all of it inlines into the caller,
+        // and so runs on the instructions it is compiled for (small.rs).
+        for g in &self.groups {
+            let mut hit = false;
+            for t in distances(g, o, d, tmax) {
+                hit |= t < tmax;
+            }
+            if hit {
+                return true;
+            }
+        }
+        false
     }
 }
 

@@ -73,7 +73,7 @@ impl QuadLanes {
     /// the ray `o + t·d` meets at 0 < t < tmax (each at that distance, if
     /// several are): the nearest hit and, of equal ones, any tie-break the
     /// caller applies come out as from every hit.
-    #[inline]
+    #[inline(always)]
     pub fn for_each_nearest(&self, o: Vec3, d: Vec3, tmax: f32, mut found: impl FnMut(f32, u32)) {
         for g in &self.groups {
             let t = distances(g, o, d, tmax);
@@ -89,9 +89,20 @@ impl QuadLanes {
     }
 
     /// Whether any quad meets the ray at 0 < t < tmax.
-    #[inline]
+    #[inline(always)]
     pub fn any_hit(&self, o: Vec3, d: Vec3, tmax: f32) -> bool {
-        self.groups.iter().any(|g| distances(g, o, d, tmax).iter().any(|&t| t < tmax))
+        // Plain loops, no closures: all of it inlines into the caller,
+        // and so runs on the instructions it is compiled for (small.rs).
+        for g in &self.groups {
+            let mut hit = false;
+            for t in distances(g, o, d, tmax) {
+                hit |= t < tmax;
+            }
+            if hit {
+                return true;
+            }
+        }
+        false
     }
 }
 
