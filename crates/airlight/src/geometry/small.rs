@@ -11,9 +11,10 @@
 //! the hits are the same bit for bit. On an Intel Xeon with AVX-512 the
 //! Cornell box's path tracing took 0.94× the baseline's time on AVX2 and
 //! 0.91× on AVX-512, the viewer's flight 0.90× and 0.86× (6 side-by-side
-//! pairs each). The loops below and in the lanes are plain `for` loops:
-//! what a closure holds may be compiled apart from its caller, for the
-//! baseline. (The quads' lanes alone compiled for AVX gave no gain on an
+//! pairs each). Everything the tests do must inline into each copy: the
+//! shadow test's `Iterator::any` with a closure was compiled apart, for the
+//! baseline, and cost 1.06×, so the loops here and in the lanes are plain
+//! `for` loops. (The quads' lanes alone compiled for AVX gave no gain on an
 //! AMD Zen 5: the divisions take as long.)
 
 use super::Hit;
@@ -42,6 +43,7 @@ pub(super) struct Small {
 
 /// The instruction sets the small scene's tests are compiled for.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(not(target_arch = "x86_64"), allow(dead_code))]
 enum Isa {
     Baseline,
     /// AVX2 and FMA.
@@ -149,6 +151,8 @@ impl Small {
         }
     }
 
+    // Each copy is a call of its own, so that `nearest` stays small enough
+    // to inline into its callers.
     #[inline(never)]
     fn nearest_baseline(&self, records: &[Record], o: Vec3, d: Vec3, tmax: f32, best: &mut Hit) {
         self.nearest_here(records, o, d, tmax, best)
