@@ -12,6 +12,7 @@
 //! `max_element` as the same comparisons, which treat a NaN as they do), so
 //! the distances are the same bit for bit and images do not change.
 
+use super::quad_lanes::any_below;
 use glam::{Affine3A, Vec3};
 
 /// Boxes per group: one SSE register per operation.
@@ -94,14 +95,10 @@ impl BoxLanes {
     /// Whether any box meets the ray at 0 < t < tmax.
     #[inline(always)]
     pub fn any_hit(&self, o: Vec3, d: Vec3, tmax: f32) -> bool {
-        // Plain loops, no closures: all of it inlines into the caller,
-        // and so runs on the instructions it is compiled for (small.rs).
+        // A plain loop, no closure: all of it inlines into the caller, and
+        // so runs on the instructions it is compiled for (small.rs).
         for g in &self.groups {
-            let mut hit = false;
-            for t in distances(g, o, d, tmax) {
-                hit |= t < tmax;
-            }
-            if hit {
+            if any_below(distances(g, o, d, tmax), tmax) {
                 return true;
             }
         }

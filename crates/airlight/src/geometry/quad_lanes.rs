@@ -91,19 +91,26 @@ impl QuadLanes {
     /// Whether any quad meets the ray at 0 < t < tmax.
     #[inline(always)]
     pub fn any_hit(&self, o: Vec3, d: Vec3, tmax: f32) -> bool {
-        // Plain loops, no closures: all of it inlines into the caller,
-        // and so runs on the instructions it is compiled for (small.rs).
+        // A plain loop, no closure: all of it inlines into the caller, and
+        // so runs on the instructions it is compiled for (small.rs).
         for g in &self.groups {
-            let mut hit = false;
-            for t in distances(g, o, d, tmax) {
-                hit |= t < tmax;
-            }
-            if hit {
+            if any_below(distances(g, o, d, tmax), tmax) {
                 return true;
             }
         }
         false
     }
+}
+
+/// Whether any lane's distance is below `tmax`: a loop without branches
+/// (and without a closure, which could be compiled apart from the caller).
+#[inline(always)]
+pub(super) fn any_below<const N: usize>(distances: [f32; N], tmax: f32) -> bool {
+    let mut hit = false;
+    for t in distances {
+        hit |= t < tmax;
+    }
+    hit
 }
 
 /// Each lane's hit distance in (0, tmax), or infinity: `intersect_quad`'s
