@@ -176,6 +176,11 @@ pub fn intersect_sphere(center: Vec3, radius: f32, o: Vec3, d: Vec3, tmin: f32, 
     let a = d.length_squared();
     let b = oc.dot(d);
     let c = oc.length_squared() - radius * radius;
+    // From outside and moving away both roots are negative (q < 0 below,
+    // so c/q and q/a are): the answer the rest would give, sooner.
+    if c > 0.0 && b > 0.0 && tmin >= 0.0 {
+        return f32::INFINITY;
+    }
     let foot = oc - d * (b / a);
     let disc = a * (radius * radius - foot.length_squared());
     if disc < 0.0 {
