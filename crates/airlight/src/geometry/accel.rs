@@ -310,7 +310,7 @@ impl Geometry {
 
     /// Whether a bounded primitive blocks the segment, testing them all.
     pub(super) fn occluded_linear(&self, origin: Vec3, dir: Vec3, tmax: f32) -> bool {
-        self.records.iter().any(|rec| rec.prim.blocks(origin, dir, tmax))
+        self.records.iter().any(|rec| rec.prim.intersect(origin, dir, 0.0, tmax) < tmax)
     }
 
     /// The tree, if the scene has one.
@@ -342,13 +342,6 @@ impl Geometry {
     #[inline(always)]
     pub(super) fn intersect_one(&self, i: usize, o: Vec3, d: Vec3, tmax: f32) -> f32 {
         self.records[i].prim.intersect(o, d, 0.0, tmax)
-    }
-
-    /// Whether record `i` meets the segment 0 < t < tmax ([`Prim::blocks`]):
-    /// the shadow-ray form of [`Geometry::intersect_one`].
-    #[inline(always)]
-    pub(super) fn blocks_one(&self, i: usize, o: Vec3, d: Vec3, tmax: f32) -> bool {
-        self.records[i].prim.blocks(o, d, tmax)
     }
 
     /// Whether any primitive is a signed distance field.

@@ -308,7 +308,7 @@ impl Geometry {
         if mixed {
             for k in bits(rays) {
                 let (o, d) = p.ray(k);
-                if (first..first + count).any(|i| self.blocks_one(i as usize, o, d, p.tmax[k])) {
+                if (first..first + count).any(|i| self.intersect_one(i as usize, o, d, p.tmax[k]) < p.tmax[k]) {
                     blocked |= 1 << k;
                 }
             }

@@ -178,7 +178,7 @@ impl Geometry {
             if !mixed {
                 return triangles(first, count);
             }
-            (first..first + count).any(|i| self.blocks_one(i as usize, origin, dir, tmax))
+            (first..first + count).any(|i| self.intersect_one(i as usize, origin, dir, tmax) < tmax)
         })
     }
 

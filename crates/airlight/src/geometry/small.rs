@@ -230,7 +230,7 @@ impl Small {
             return true;
         }
         for other in &self.others {
-            if other.may_hit(o, d) && records[other.index as usize].prim.blocks(o, d, tmax) {
+            if other.may_hit(o, d) && records[other.index as usize].prim.intersect(o, d, 0.0, tmax) < tmax {
                 return true;
             }
         }
