@@ -26,7 +26,7 @@ use crate::sampling::{Sampler, to_world};
 use crate::scene::Scene;
 use glam::{Vec2, Vec3};
 use guide::{GUIDE_PROBABILITY, Guide, mixed_pdf};
-use nee::{Along, Fog, Segment, direct_light, equiangular_applies, equiangular_light};
+use nee::{Fog, Segment, direct_light, equiangular_applies, equiangular_light};
 use tracking::free_flight;
 
 /// Volumetric path tracer. `max_depth` counts scattering events: 1 is direct
@@ -119,24 +119,15 @@ pub(super) struct Bounce {
     pub direction: Vec2,
 }
 
-/// Where light scatters: a surface or a point in the medium (with its
-/// place on an equiangularly sampled segment, if any); `wo` points back
-/// along the path, toward where the light will go.
+/// Where light scatters: a surface or a point in the medium; `wo` points
+/// back along the path, toward where the light will go.
 enum Vertex<'a> {
     /// `material` as it is at the hit (a texture looked up);
     /// `light_numbers`, if stratified, the light samples' numbers.
-    Surface {
-        p: Vec3,
-        n: Vec3,
-        wo: Vec3,
-        material: &'a Material,
-        light_numbers: Option<Vec2>,
-    },
-    Medium {
-        p: Vec3,
-        wo: Vec3,
-        along: Option<Along<'a>>,
-    },
+    Surface { p: Vec3, n: Vec3, wo: Vec3, material: &'a Material, light_numbers: Option<Vec2> },
+    /// `on_gathered_segment`: on a segment whose delta lights' scattered
+    /// light was gathered equiangularly (nee.rs).
+    Medium { p: Vec3, wo: Vec3, on_gathered_segment: bool },
 }
 
 impl Vertex<'_> {
@@ -240,10 +231,10 @@ impl PathTracer {
                 // Delta lights' light scattered along the segment, also from
                 // equiangular points (nee.rs), when a scattering event here
                 // would still count.
-                let mut segment = Segment::new(ray, t_medium);
+                let segment = Segment::new(ray, t_medium);
                 let equiangular = self.gathers(Some(m), depth);
                 if equiangular {
-                    l += equiangular_light(scene, m, &mut segment, beta, r_u, hero, sampler);
+                    l += equiangular_light(scene, m, &segment, beta, r_u, hero, sampler);
                 }
                 if std::mem::take(&mut roulette_pending) && !russian_roulette(&mut beta, r_u, depth, sampler) {
                     return l;
@@ -270,7 +261,6 @@ impl PathTracer {
                         // whose cause is not yet understood.
                         let direction = sampler.next2();
                         let pdf = c.t_maj[hero] * c.sigma_s[hero];
-                        let along = equiangular.then(|| Along { segment: &segment, t: c.t, r_equiangular: r_u / pdf });
                         beta *= c.t_maj * c.sigma_s / pdf;
                         r_u *= c.t_maj * c.sigma_s / pdf;
                         if beta.max_element() <= 0.0 || r_u.max_element() <= 0.0 {
@@ -280,7 +270,7 @@ impl PathTracer {
                         let p = ray.at(c.t);
                         let wo = -ray.dir;
                         let guide = if self.guides(Some(m), depth) { Guide::at(scene, p) } else { None };
-                        let vertex = Vertex::Medium { p, wo, along };
+                        let vertex = Vertex::Medium { p, wo, on_gathered_segment: equiangular };
                         let fog = Fog { medium: Some(m), closed_form: self.closed_form };
                         l += beta * direct_light(scene, fog, &vertex, r_u, hero, guide.as_ref(), sampler);
                         let (wi, phase) = match guided(guide.as_ref(), sampler) {
