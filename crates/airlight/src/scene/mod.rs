@@ -230,7 +230,11 @@ impl Scene {
     /// coordinates ([`Material::at_uv`]).
     #[inline]
     pub fn material_at(&self, surface: &SurfaceHit) -> Material {
-        self.material(surface.material).at_uv(surface.uv)
+        let material = self.material(surface.material);
+        match material {
+            Material::Textured { .. } => material.at_uv(self.geometry.uv(surface)),
+            _ => material.clone(),
+        }
     }
 
     pub fn lights(&self) -> &[Light] {
