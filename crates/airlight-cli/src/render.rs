@@ -40,6 +40,10 @@ pub struct RenderArgs {
     /// Stochastic: independent random samples instead of stratified ones.
     #[arg(long)]
     no_stratify: bool,
+    /// Path: neighbouring pixels' paths share what they gather beyond their
+    /// second vertex (scenes without a medium). As `[render] reuse`.
+    #[arg(long)]
+    reuse: bool,
     /// Render in passes of 1, 1, 2, 4, ... samples per pixel up to spp,
     /// rewriting the output after each pass.
     #[arg(long)]
@@ -367,6 +371,9 @@ fn configure(args: &RenderArgs) -> Result<SceneFile, String> {
     }
     if let Some(v) = args.sampling {
         d.stochastic.sampling = v;
+    }
+    if args.reuse {
+        d.path.reuse = true;
     }
     if args.no_stratify {
         d.stochastic.stratify = false;

@@ -240,7 +240,7 @@ fn packets_of_samples_give_the_one_by_one_image() {
     batched_render_matches_samples_one_by_one(&busy_scene(), &Direct);
     // Meshes, boxes and quads that share edges and faces; area lights; the
     // lamp room's fog for the path tracer.
-    let path_tracer = PathTracer::new(PathOptions { max_depth: 3, stratify: true });
+    let path_tracer = PathTracer::new(PathOptions { max_depth: 3, stratify: true, reuse: false });
     for name in ["gltf_lamp_room_fog.toml", "compare_cornell.toml"] {
         let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes").join(name);
         let mut scene = airlight::SceneFile::load(&path).expect("scene loads").scene;

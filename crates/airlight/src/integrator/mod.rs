@@ -59,7 +59,7 @@ pub trait Integrator: Send + Sync {
 
     /// Radiance along many camera rays, each with its own sampler:
     /// `out[i]` is `self.radiance(scene, &rays[i], &mut samplers[i])`, bit
-    /// for bit. The render loop hands over the samples of a block of
+    /// for bit, unless [`Integrator::shares_between_pixels`]. The render loop hands over the samples of a block of
     /// neighbouring pixels, so that integrators may trace their coherent
     /// rays together (see `Geometry::intersect_packet`); by default, one
     /// sample after another.
@@ -67,6 +67,14 @@ pub trait Integrator: Send + Sync {
         for ((ray, sampler), out) in rays.iter().zip(samplers.iter_mut()).zip(out.iter_mut()) {
             *out = self.radiance(scene, ray, sampler);
         }
+    }
+
+    /// Whether [`Integrator::radiance_batch`] lets the batch's samples share
+    /// what they found (the path tracer's path reuse): each `out[i]` is
+    /// then still an unbiased estimate of its pixel, but depends on the
+    /// batch's other samples and is not `radiance`'s value.
+    fn shares_between_pixels(&self) -> bool {
+        false
     }
 
     /// The scene's lights changed ([`Scene::set_lights`], [`Scene::at_time`]):

@@ -111,11 +111,15 @@ pub struct PathOptions {
     /// Draw each bounce's light sample and scattering direction from the
     /// pixel's Owen-scrambled Sobol' points rather than independently.
     pub stratify: bool,
+    /// Let the paths of neighbouring pixels (a batch's groups of four)
+    /// share what they gather beyond their second vertex, in scenes
+    /// without a medium (`integrator/path/reuse.rs`).
+    pub reuse: bool,
 }
 
 impl Default for PathOptions {
     fn default() -> Self {
-        PathOptions { max_depth: 8, stratify: true }
+        PathOptions { max_depth: 8, stratify: true, reuse: false }
     }
 }
 
@@ -260,6 +264,9 @@ impl IntegratorDesc {
         if let Some(v) = r.stratify {
             d.stochastic.stratify = v;
             d.path.stratify = v;
+        }
+        if let Some(v) = r.reuse {
+            d.path.reuse = v;
         }
         if let Some(v) = &r.max_depth {
             d.path.max_depth = render_count(v, "max_depth", 1, MAX_DEPTH)?;

@@ -41,9 +41,11 @@
 //! Cornell box's squared error at 512 spp was 1.06× this one's.
 
 use super::{RenderObserver, accumulate_pixel_samples};
+use crate::Rgb;
 use crate::film::{Accumulator, Image};
+use crate::geometry::Ray;
 use crate::integrator::Integrator;
-use crate::sampling::mix64;
+use crate::sampling::{Sampler, mix64};
 use crate::scene::Scene;
 
 /// The most samples a pixel may take in stage 2, as a multiple of the
@@ -90,8 +92,27 @@ pub fn pilot(scene: &Scene, integrator: &dyn Integrator, observer: &RenderObserv
     let s = scene.settings();
     let mut sums = Accumulator::new(s.width, s.height);
     let pilot = pilot_samples(s.spp) as u64;
+    // A pixel's count follows its neighbours' pilot noise; were their
+    // pilot samples to share this pixel's paths, its count would follow
+    // its own samples, and its mean would be biased.
+    let alone = OneByOne(integrator);
+    let integrator = if integrator.shares_between_pixels() { &alone } else { integrator };
     accumulate_pixel_samples(scene, integrator, s.seed, |_, _| 0..pilot, &mut sums, observer);
     sums
+}
+
+/// An integrator whose samples are traced one by one (the trait's own
+/// `radiance_batch`), so that no pixel's sample depends on another's.
+struct OneByOne<'a>(&'a dyn Integrator);
+
+impl Integrator for OneByOne<'_> {
+    fn radiance(&self, scene: &Scene, ray: &Ray, sampler: &mut Sampler) -> Rgb {
+        self.0.radiance(scene, ray, sampler)
+    }
+
+    fn stratified(&self) -> bool {
+        self.0.stratified()
+    }
 }
 
 /// From the pilot's sums, each pixel's count of samples in stage 2 (row by

@@ -80,6 +80,8 @@ pub struct RenderDesc {
     pub sampling: Option<Spanned<String>>,
     /// Stochastic: stratify each pixel's samples.
     pub stratify: Option<bool>,
+    /// Path: neighbouring pixels' paths share their second vertices.
+    pub reuse: Option<bool>,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]

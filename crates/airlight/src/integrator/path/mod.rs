@@ -14,6 +14,7 @@
 
 mod guide;
 mod nee;
+mod reuse;
 pub mod tracking;
 
 use super::{Integrator, PathOptions};
@@ -27,6 +28,7 @@ use crate::scene::Scene;
 use glam::{Vec2, Vec3};
 use guide::{GUIDE_PROBABILITY, Guide, mixed_pdf};
 use nee::{Fog, Segment, direct_light, equiangular_applies, equiangular_light};
+use reuse::{FirstVertex, SecondVertex, Split};
 use tracking::free_flight;
 
 /// Volumetric path tracer. `max_depth` counts scattering events: 1 is direct
@@ -54,6 +56,9 @@ pub struct PathTracer {
     /// new direction come from the pixel's Owen-scrambled Sobol' points
     /// (`Bounce`).
     pub stratify: bool,
+    /// Share second vertices among neighbouring pixels' paths (reuse.rs),
+    /// in scenes without a medium.
+    pub reuse: bool,
 }
 
 impl PathTracer {
@@ -64,6 +69,7 @@ impl PathTracer {
             closed_form: true,
             guide: true,
             stratify: options.stratify,
+            reuse: options.reuse,
         }
     }
 
@@ -180,8 +186,12 @@ impl Integrator for PathTracer {
         self.stratify
     }
 
+    fn shares_between_pixels(&self) -> bool {
+        self.reuse
+    }
+
     fn radiance(&self, scene: &Scene, camera_ray: &Ray, sampler: &mut Sampler) -> Rgb {
-        self.trace(scene, camera_ray, None, sampler)
+        self.trace(scene, camera_ray, None, sampler, None)
     }
 
     /// The camera rays' first hits found together as packets (bit for bit
@@ -189,8 +199,23 @@ impl Integrator for PathTracer {
     fn radiance_batch(&self, scene: &Scene, rays: &[Ray], samplers: &mut [Sampler], out: &mut [Rgb]) {
         let mut hits = vec![None; rays.len()];
         scene.geometry().intersect_packet(rays, f32::INFINITY, &mut hits);
+        if self.reuse && scene.medium().is_none() {
+            let mut splits = vec![Split::default(); rays.len()];
+            let mut traced = vec![Rgb::ZERO; rays.len()];
+            for ((((ray, hit), sampler), split), traced) in
+                rays.iter().zip(hits).zip(samplers.iter_mut()).zip(splits.iter_mut()).zip(traced.iter_mut())
+            {
+                *traced = self.trace(scene, ray, Some(hit), sampler, Some(split));
+            }
+            for ((splits, traced), out) in
+                splits.chunks(reuse::GROUP).zip(traced.chunks(reuse::GROUP)).zip(out.chunks_mut(reuse::GROUP))
+            {
+                reuse::share(scene, splits, traced, out);
+            }
+            return;
+        }
         for (((ray, hit), sampler), out) in rays.iter().zip(hits).zip(samplers.iter_mut()).zip(out.iter_mut()) {
-            *out = self.trace(scene, ray, Some(hit), sampler);
+            *out = self.trace(scene, ray, Some(hit), sampler, None);
         }
     }
 }
@@ -204,6 +229,7 @@ impl PathTracer {
         camera_ray: &Ray,
         mut camera_hit: Option<Option<Hit>>,
         sampler: &mut Sampler,
+        mut split: Option<&mut Split>,
     ) -> Rgb {
         let medium = scene.medium();
         let max_distance = scene.settings().max_distance;
@@ -221,6 +247,9 @@ impl PathTracer {
         // its estimate, a thousandfold. (Traced in a firefly that guiding
         // left: a pixel at 2470 where its median is 0.15.)
         let mut roulette_pending = false;
+        // The weight Russian roulette sees is β times this: the path's
+        // weight at its shared second vertex, where β starts again at 1.
+        let mut roulette_scale = Rgb::ONE;
         loop {
             let hit = camera_hit.take().unwrap_or_else(|| scene.geometry().intersect(&ray, f32::INFINITY));
             let t_hit = hit.map_or(f32::INFINITY, |h| h.t);
@@ -236,7 +265,9 @@ impl PathTracer {
                 if equiangular {
                     l += equiangular_light(scene, m, &segment, beta, r_u, hero, sampler);
                 }
-                if std::mem::take(&mut roulette_pending) && !russian_roulette(&mut beta, r_u, depth, sampler) {
+                if std::mem::take(&mut roulette_pending)
+                    && !russian_roulette(&mut beta, roulette_scale, r_u, depth, sampler)
+                {
                     return l;
                 }
                 let mut scattered: Option<Ray> = None;
@@ -322,7 +353,7 @@ impl PathTracer {
                     ray = next;
                     if self.gathers(medium, depth) {
                         roulette_pending = true;
-                    } else if !russian_roulette(&mut beta, r_u, depth, sampler) {
+                    } else if !russian_roulette(&mut beta, roulette_scale, r_u, depth, sampler) {
                         return l;
                     }
                     continue;
@@ -368,6 +399,14 @@ impl PathTracer {
             depth += 1;
             let numbers = self.bounce(depth, sampler);
             let material = scene.material_at(&surface);
+            if depth == 2
+                && let Some(split) = split.as_deref_mut()
+                && split.first.is_some()
+                && reuse::lambertian(&material)
+            {
+                split.second = Some(SecondVertex { p: surface.p, n: surface.n, own: l });
+                (roulette_scale, beta, l) = (beta, Rgb::ONE, Rgb::ZERO);
+            }
             let wo = -ray.dir;
             let vertex =
                 Vertex::Surface { p: surface.p, n: surface.n, wo, material: &material, light_numbers: numbers.light };
@@ -398,9 +437,14 @@ impl PathTracer {
             if beta.max_element() <= 0.0 {
                 return l;
             }
+            if depth == 1
+                && let Some(split) = split.as_deref_mut()
+            {
+                split.first = Some(FirstVertex { p: surface.p, n: surface.n, wo, material: material.clone() });
+            }
             if self.gathers(medium, depth) {
                 roulette_pending = true;
-            } else if !russian_roulette(&mut beta, r_u, depth, sampler) {
+            } else if !russian_roulette(&mut beta, roulette_scale, r_u, depth, sampler) {
                 return l;
             }
         }
@@ -428,8 +472,8 @@ const RUSSIAN_ROULETTE_FROM: u32 = 5;
 /// Russian roulette from event [`RUSSIAN_ROULETTE_FROM`] on, on the path's
 /// weight: false if the path ends, else `beta` is raised to keep the
 /// estimate unbiased.
-fn russian_roulette(beta: &mut Rgb, r_u: Rgb, depth: u32, sampler: &mut Sampler) -> bool {
-    let rr = (*beta / avg(r_u)).max_element();
+fn russian_roulette(beta: &mut Rgb, scale: Rgb, r_u: Rgb, depth: u32, sampler: &mut Sampler) -> bool {
+    let rr = (*beta * scale / avg(r_u)).max_element();
     if rr < 1.0 && depth >= RUSSIAN_ROULETTE_FROM {
         let q = (1.0 - rr).max(0.0);
         if sampler.next() < q {
