@@ -30,7 +30,7 @@ fn a_white_furnace_reads_one_with_paths_shared() {
         .build()
         .unwrap();
     let image = render(&scene, &reusing(10_000), &RenderObserver::none());
-    // Pixels of one group of four share samples: the standard error of the
+    // Pixels of one group of eight share samples: the standard error of the
     // mean is taken over 4×4 blocks (each block is one batch, and batches
     // share nothing).
     let blocks = block_means(&image, &image_of(&image, Rgb::ZERO));

@@ -111,7 +111,7 @@ pub struct PathOptions {
     /// Draw each bounce's light sample and scattering direction from the
     /// pixel's Owen-scrambled Sobol' points rather than independently.
     pub stratify: bool,
-    /// Let the paths of neighbouring pixels (a batch's groups of four)
+    /// Let the paths of neighbouring pixels (a batch's groups of eight)
     /// share what they gather beyond their second vertex, in scenes
     /// without a medium (`integrator/path/reuse.rs`).
     pub reuse: bool,
