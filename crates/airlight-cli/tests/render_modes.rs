@@ -1,5 +1,5 @@
 //! `airlight render` with --frames (light animation), --target-error,
-//! --variance and --adaptive.
+//! --variance, --adaptive and --reuse.
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -169,4 +169,31 @@ fn adaptive_sampling_renders_in_one_go_and_refuses_passes_and_parts() {
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(!out.status.success() && stderr.contains("does not go with adaptive"), "{stderr}");
     assert_eq!(names(d), ["a.exr", "b.exr"], "nothing else written");
+}
+
+#[test]
+fn reuse_comes_from_the_flag_or_the_scene_file_and_a_bad_value_is_placed() {
+    let dir = tempfile::tempdir().unwrap();
+    let cornell = scene("compare_cornell.toml");
+    let size = ["--width", "24", "--height", "16", "--spp", "4", "--quiet"];
+    let render = |args: &[&str], out: &str| {
+        let run = airlight(dir.path(), &[&["render"][..], args, &size, &["-o", out]].concat());
+        assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+        std::fs::read(dir.path().join(out)).unwrap()
+    };
+    let plain = render(&[&cornell], "plain.exr");
+    let flag = render(&[&cornell, "--reuse"], "flag.exr");
+    let text = std::fs::read_to_string(&cornell).unwrap().replace("[render]\n", "[render]\nreuse = true\n");
+    std::fs::write(dir.path().join("reuse.toml"), &text).unwrap();
+    let file = render(&["reuse.toml"], "file.exr");
+    // The same pixels either way, and not the plain path tracer's.
+    assert!(flag == file && flag != plain);
+    let bad = text.replace("reuse = true", "reuse = \"yes\"");
+    std::fs::write(dir.path().join("bad.toml"), bad).unwrap();
+    let run = airlight(dir.path(), &[&["render", "bad.toml"][..], &size].concat());
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert!(
+        !run.status.success() && stderr.contains("bad.toml:5") && stderr.contains("expected a boolean"),
+        "{stderr}"
+    );
 }
