@@ -59,10 +59,10 @@ pub trait Integrator: Send + Sync {
 
     /// Radiance along many camera rays, each with its own sampler:
     /// `out[i]` is `self.radiance(scene, &rays[i], &mut samplers[i])`, bit
-    /// for bit, unless [`Integrator::shares_between_pixels`]. The render loop hands over the samples of a block of
-    /// neighbouring pixels, so that integrators may trace their coherent
-    /// rays together (see `Geometry::intersect_packet`); by default, one
-    /// sample after another.
+    /// for bit, unless [`Integrator::shares_between_pixels`]. The render
+    /// loop hands over the samples of a block of neighbouring pixels, so
+    /// that integrators may trace their coherent rays together (see
+    /// `Geometry::intersect_packet`); by default, one sample after another.
     fn radiance_batch(&self, scene: &Scene, rays: &[Ray], samplers: &mut [Sampler], out: &mut [Rgb]) {
         for ((ray, sampler), out) in rays.iter().zip(samplers.iter_mut()).zip(out.iter_mut()) {
             *out = self.radiance(scene, ray, sampler);

@@ -265,6 +265,13 @@ impl Light {
         matches!(self, Light::Point { .. } | Light::Spot { .. } | Light::Distant { .. } | Light::Line { .. })
     }
 
+    /// Whether the light is a delta light with a place (point, spot and line
+    /// lights, not a sun): the lights whose scattered light the path tracer
+    /// gathers equiangularly along segments in fog.
+    pub fn is_placed_delta(&self) -> bool {
+        self.is_delta() && self.anchor().is_some()
+    }
+
     /// Samples light arriving at `p`; `u` uniform in [0, 1)². None when no light
     /// arrives from the sample (outside a spot's cone, behind a quad light).
     pub fn sample(&self, p: Vec3, u: Vec2) -> Option<LightSample> {

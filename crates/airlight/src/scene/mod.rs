@@ -383,8 +383,7 @@ pub struct Surface {
 
 /// See [`Scene::placed_delta_lights`].
 fn placed_delta(lights: &[Light]) -> Vec<u32> {
-    let placed = |light: &Light| light.is_delta() && light.anchor().is_some();
-    lights.iter().enumerate().filter(|(_, light)| placed(light)).map(|(i, _)| i as u32).collect()
+    lights.iter().enumerate().filter(|(_, light)| light.is_placed_delta()).map(|(i, _)| i as u32).collect()
 }
 
 fn build_geometry(surfaces: impl Iterator<Item = Surface>) -> Geometry {

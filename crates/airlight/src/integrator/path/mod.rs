@@ -441,8 +441,9 @@ fn guided<'a>(guide: Option<&'a Guide>, sampler: &mut Sampler) -> Option<(&'a Gu
 const RUSSIAN_ROULETTE_FROM: u32 = 5;
 
 /// Russian roulette from event [`RUSSIAN_ROULETTE_FROM`] on, on the path's
-/// weight: false if the path ends, else `beta` is raised to keep the
-/// estimate unbiased.
+/// weight `beta · scale` (`scale` is 1 but after a shared second vertex,
+/// where `beta` starts again: reuse.rs): false if the path ends, else
+/// `beta` is raised to keep the estimate unbiased.
 fn russian_roulette(beta: &mut Rgb, scale: Rgb, r_u: Rgb, depth: u32, sampler: &mut Sampler) -> bool {
     let rr = (*beta * scale / avg(r_u)).max_element();
     if rr < 1.0 && depth >= RUSSIAN_ROULETTE_FROM {

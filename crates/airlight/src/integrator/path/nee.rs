@@ -57,10 +57,10 @@ impl Segment {
     }
 
     /// The equiangular distribution of the segment about `light`, for the
-    /// lights it applies to ([`gathered_along_segments`]; a line light's
+    /// lights it applies to ([`Light::is_placed_delta`]; a line light's
     /// centre, spread by its length).
     fn equiangular(&self, light: &Light) -> Option<Equiangular> {
-        if !gathered_along_segments(light) {
+        if !light.is_placed_delta() {
             return None;
         }
         let (y, spread) = light.anchor()?;
@@ -72,13 +72,6 @@ impl Segment {
         let t = (center - self.ray.origin).dot(self.ray.dir).clamp(0.0, self.length);
         self.ray.at(t).distance_squared(center) <= radius * radius
     }
-}
-
-/// Whether a light's scattered light is gathered equiangularly along
-/// segments (then collisions on those segments leave it out): point, spot
-/// and line lights, the delta lights with a place.
-fn gathered_along_segments(light: &Light) -> bool {
-    light.is_delta() && light.anchor().is_some()
 }
 
 /// The light of the delta lights scattered along `segment` toward its
@@ -173,7 +166,7 @@ pub(super) fn direct_light(
     let key = sampler.next_key();
     let mut total = Rgb::ZERO;
     scene.for_each_emitter_at(p, |index, light| {
-        if on_gathered_segment && gathered_along_segments(light) {
+        if on_gathered_segment && light.is_placed_delta() {
             return;
         }
         let u = match stratified {
