@@ -192,7 +192,7 @@ impl<const W: usize> Bvh<W> {
     /// rays across its inside 1.05× (bench_bvh, 4 side-by-side pairs each,
     /// measured on four-wide trees), with the same tree and so the same hits.
     pub fn from_bvh2(bvh2: &Bvh2, mixed: impl Fn(u32, u32) -> bool) -> Self {
-        let mut nodes = Vec::with_capacity(bvh2.nodes.len() / (2 * (W - 1)) + 1);
+        let mut nodes = super::pages::vec_in_huge_pages(bvh2.nodes.len() / (2 * (W - 1)) + 1);
         nodes.push(Node::EMPTY);
         let root = &bvh2.nodes[0];
         let mut depth = 1;

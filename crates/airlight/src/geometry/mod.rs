@@ -7,6 +7,7 @@ mod bvh;
 mod lanes;
 mod one_ray;
 mod packet;
+mod pages;
 mod quad_lanes;
 mod ray;
 mod records;
