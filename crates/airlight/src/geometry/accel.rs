@@ -193,9 +193,8 @@ impl GeometryBuilder {
         }
         let bvh2 = obvhs::bvh2::builder::build_bvh2(&records, params, &mut Duration::default());
         // Reorder so that the tree's leaf ranges index `records` directly.
-        let mut ordered = super::pages::vec_in_huge_pages(records.len());
-        ordered.extend(bvh2.primitive_indices.iter().map(|&i| records[i as usize].clone()));
-        let records: Vec<Record> = ordered;
+        let records: Vec<Record> =
+            super::pages::collect_in_huge_pages(bvh2.primitive_indices.iter().map(|&i| records[i as usize].clone()));
         let triangles = triangles_of(&records);
         let mixed = |first: u32, count: u32| {
             records[first as usize..(first + count) as usize].iter().any(|r| !matches!(r.prim, Prim::Triangle { .. }))
@@ -208,19 +207,16 @@ impl GeometryBuilder {
             return Geometry { records, planes, unbounded, triangles, bvh: None, small: None, bounds, triangle_uvs };
         }
         let small = small_scene(&records);
-        super::pages::move_to_huge_pages(&bvh.nodes);
         Geometry { records, planes, unbounded, triangles, bvh: Some(bvh), small, bounds, triangle_uvs }
     }
 }
 
 /// The (v0, e1, e2) of every triangle record, zeros for other primitives.
 fn triangles_of(records: &[Record]) -> Vec<[Vec3; 3]> {
-    let mut triangles = super::pages::vec_in_huge_pages(records.len());
-    triangles.extend(records.iter().map(|r| match r.prim {
+    super::pages::collect_in_huge_pages(records.iter().map(|r| match r.prim {
         Prim::Triangle { v0, e1, e2 } => [v0, e1, e2],
         _ => [Vec3::ZERO; 3],
-    }));
-    triangles
+    }))
 }
 
 impl Geometry {

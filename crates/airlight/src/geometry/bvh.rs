@@ -109,9 +109,16 @@ fn hit<B: Lanes, const W: usize>(node: &Node<W>, ray: &BoxRay, tmax: f32) -> (u3
     let mut out = [0.0f32; W];
     let mut at = 0;
     while at < W {
-        let slab = |row: usize, axis: usize| slab::<B, W>(node, ray, at, row, axis);
-        let n = [slab(ray.near[0], 0), slab(ray.near[1], 1), slab(ray.near[2], 2)];
-        let f = [slab(far_row(ray.near[0], 0), 0), slab(far_row(ray.near[1], 1), 1), slab(far_row(ray.near[2], 2), 2)];
+        let n = [
+            slab::<B, W>(node, ray, at, ray.near[0], 0),
+            slab::<B, W>(node, ray, at, ray.near[1], 1),
+            slab::<B, W>(node, ray, at, ray.near[2], 2),
+        ];
+        let f = [
+            slab::<B, W>(node, ray, at, far_row(ray.near[0], 0), 0),
+            slab::<B, W>(node, ray, at, far_row(ray.near[1], 1), 1),
+            slab::<B, W>(node, ray, at, far_row(ray.near[2], 2), 2),
+        ];
         let tnear = n[0].max(n[1]).max(n[2].max(B::splat(0.0)));
         let tfar = f[0].min(f[1]).min(f[2].min(B::splat(tmax))).mul(B::splat(FAR_SCALE));
         mask |= tnear.le(tfar) << at;
@@ -241,6 +248,8 @@ impl<const W: usize> Bvh<W> {
                 }
             }
         }
+        // The node count was estimated: nodes past the estimate moved.
+        super::pages::move_to_huge_pages(&nodes);
         Bvh { nodes, depth }
     }
 

@@ -2,8 +2,8 @@
 //!
 //! A ray through a mesh of a million triangles visits a few dozen nodes and
 //! leaves scattered over tens of megabytes. With 4 KB pages nearly every
-//! visit also misses the processor's page-translation cache (a few
-//! thousand entries: about 6 MB of 4 KB pages) and waits on a page walk
+//! visit also misses the processor's page-translation cache (one to a few
+//! thousand entries: a few megabytes of 4 KB pages) and waits on a page walk
 //! before its fetch can start; with 2 MB pages the same entries cover
 //! gigabytes. Linux gives 2 MB pages to anonymous memory that asks for
 //! them (`madvise(MADV_HUGEPAGE)`) when transparent huge pages are set to
@@ -24,6 +24,13 @@ const WORTHWHILE: usize = 8 << 20;
 pub(super) fn vec_in_huge_pages<T>(len: usize) -> Vec<T> {
     let v = Vec::with_capacity(len);
     advise(v.as_ptr(), len * std::mem::size_of::<T>(), false);
+    v
+}
+
+/// The items collected into a vector born in huge pages.
+pub(super) fn collect_in_huge_pages<T>(items: impl ExactSizeIterator<Item = T>) -> Vec<T> {
+    let mut v = vec_in_huge_pages(items.len());
+    v.extend(items);
     v
 }
 
@@ -75,8 +82,7 @@ mod tests {
     #[test]
     fn advised_vectors_keep_their_contents() {
         let n = (6 << 20) + 12345; // 24 MB of u32
-        let mut v: Vec<u32> = vec_in_huge_pages(n);
-        v.extend((0..n as u32).map(|i| i.wrapping_mul(2_654_435_761)));
+        let v: Vec<u32> = collect_in_huge_pages((0..n as u32).map(|i| i.wrapping_mul(2_654_435_761)));
         move_to_huge_pages(&v);
         assert!(v.iter().enumerate().all(|(i, &x)| x == (i as u32).wrapping_mul(2_654_435_761)));
     }
