@@ -291,29 +291,54 @@ impl<const W: usize> Bvh<W> {
             } else {
                 let node = &self.nodes[current.child as usize];
                 let (mask, tnear) = hit::<B, W>(node, ray, best_t);
-                let mut hits = [Entry { child: 0, count: 0, tnear: 0.0 }; W];
-                let mut n = 0;
-                let mut bits = mask;
-                while bits != 0 {
-                    let c = bits.trailing_zeros() as usize;
-                    bits &= bits - 1;
-                    // Sorted by decreasing distance: the nearest goes on top.
-                    let e = Entry { child: node.child[c], count: node.count[c], tnear: tnear[c] };
-                    if e.count != 0 {
-                        prefetch_leaf(e.child, e.count & COUNT_MASK);
-                    } else {
-                        super::packet::prefetch(&self.nodes[e.child as usize]);
+                if mask != 0 {
+                    // The next child: the nearest of those entered, the
+                    // others pushed, each prefetched. One or two children
+                    // entered, the common cases, take no sort: the step from
+                    // a node to its child is a chain of dependent loads.
+                    let entry = |c: usize| {
+                        let e = Entry { child: node.child[c], count: node.count[c], tnear: tnear[c] };
+                        if e.count != 0 {
+                            prefetch_leaf(e.child, e.count & COUNT_MASK);
+                        } else {
+                            super::packet::prefetch(&self.nodes[e.child as usize]);
+                        }
+                        e
+                    };
+                    let first = entry(mask.trailing_zeros() as usize);
+                    let rest = mask & (mask - 1);
+                    if rest == 0 {
+                        current = first;
+                        continue;
                     }
-                    let mut i = n;
-                    while i > 0 && hits[i - 1].tnear < e.tnear {
-                        hits[i] = hits[i - 1];
-                        i -= 1;
+                    let second = entry(rest.trailing_zeros() as usize);
+                    let mut bits = rest & (rest - 1);
+                    if bits == 0 {
+                        // Of equal distances the later child first, as below.
+                        let (near, far) = if first.tnear < second.tnear { (first, second) } else { (second, first) };
+                        stack.push(far);
+                        current = near;
+                        continue;
                     }
-                    hits[i] = e;
-                    n += 1;
-                }
-                if n > 0 {
-                    // The nearest child next; the others wait on the stack.
+                    // Three or more: by decreasing distance, the nearest last.
+                    let mut hits = [first; W];
+                    let mut n = 1;
+                    let mut e = second;
+                    loop {
+                        let mut i = n;
+                        while i > 0 && hits[i - 1].tnear < e.tnear {
+                            hits[i] = hits[i - 1];
+                            i -= 1;
+                        }
+                        hits[i] = e;
+                        n += 1;
+                        if bits == 0 {
+                            break;
+                        }
+                        let c = bits.trailing_zeros() as usize;
+                        bits &= bits - 1;
+                        e = entry(c);
+                    }
                     for e in &hits[..n - 1] {
                         stack.push(*e);
                     }
