@@ -1,6 +1,6 @@
 //! Primary-ray throughput on a mesh of over a million triangles.
 //!
-//! `cargo run --release --example bench_bvh [-- SUBDIVISIONS] [--no-reference]`
+//! `cargo run --release --example bench_bvh [-- SUBDIVISIONS] [--no-reference] [--dump-rays DIR]`
 //!
 //! Builds a displaced sphere (a UV sphere with SUBDIVISIONS² quads, default
 //! 750² → 1.12 M triangles, radius modulated by a sum of sines), frames it
@@ -24,6 +24,10 @@
 //! Each ray throughput is the median of 7 timed passes (with the range of
 //! the one-thread passes): on a shared machine one pass of about 0.1 s can
 //! be a third off.
+//!
+//! With `--dump-rays DIR` it writes the mesh and the bounce rays to DIR
+//! (`bounce_in.bin`, `bounce_out.bin`) and stops: `tools/embree_rays.c`
+//! traces them through Embree one at a time, for the figure against it.
 
 use airlight::geometry::{GeometryBuilder, Hit, LaneWidth, Ray, Segment, Shape, intersect_triangle, offset_origin};
 use airlight::integrator::{Direct, Integrator};
@@ -108,6 +112,15 @@ fn main() {
             .collect()
     };
     let (bounce_in, bounce_out) = (bounce(true), bounce(false));
+    if let Some(dir) = std::env::args().skip_while(|a| a != "--dump-rays").nth(1) {
+        let Shape::Mesh { positions, triangles, .. } = &mesh else { unreachable!() };
+        for (name, rays) in [("bounce_in.bin", &bounce_in), ("bounce_out.bin", &bounce_out)] {
+            let path = std::path::Path::new(&dir).join(name);
+            std::fs::write(&path, ray_file(positions, triangles, rays)).expect("writing the rays");
+            println!("wrote {} ({} rays)", path.display(), rays.len());
+        }
+        return;
+    }
     let hits = hit_points.iter().filter(|h| h.is_some()).count();
     println!("{} primary rays, {:.1}% hit the mesh", rays.len(), 100.0 * hits as f64 / rays.len() as f64);
     // One shadow ray from each hit toward a point light, as direct lighting
@@ -274,6 +287,23 @@ fn bounce_numbers(i: u64) -> glam::Vec2 {
     z ^= z >> 31;
     let unit = |bits: u64| bits as f32 / (1u32 << 24) as f32;
     glam::Vec2::new(unit(z >> 40), unit((z >> 8) & 0xff_ffff))
+}
+
+/// The mesh and rays for `tools/embree_rays.c`, little-endian: the vertex
+/// count and the vertices (3 f32 each), the triangle count and the
+/// triangles (3 u32 each), the ray count and the rays (origin and
+/// direction, 6 f32 each).
+fn ray_file(positions: &[Vec3], triangles: &[[u32; 3]], rays: &[Ray]) -> Vec<u8> {
+    let mut out = Vec::new();
+    out.extend_from_slice(&(positions.len() as u32).to_le_bytes());
+    positions.iter().flat_map(|p| p.to_array()).for_each(|x| out.extend_from_slice(&x.to_le_bytes()));
+    out.extend_from_slice(&(triangles.len() as u32).to_le_bytes());
+    triangles.iter().flatten().for_each(|i| out.extend_from_slice(&i.to_le_bytes()));
+    out.extend_from_slice(&(rays.len() as u32).to_le_bytes());
+    for r in rays {
+        r.origin.to_array().iter().chain(&r.dir.to_array()).for_each(|x| out.extend_from_slice(&x.to_le_bytes()));
+    }
+    out
 }
 
 /// A uniform direction: z = 1 − 2u, the azimuth 2πv.

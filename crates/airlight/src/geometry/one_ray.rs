@@ -132,7 +132,12 @@ impl Geometry {
     unsafe fn occluded_bvh_avx(&self, bvh: &Bvh8, origin: Vec3, dir: Vec3, tmax: f32) -> bool {
         #[target_feature(enable = "avx")]
         unsafe fn leaf(g: &Geometry, first: u32, count: u32, o: Vec3, d: Vec3, tmax: f32) -> bool {
-            g.leaf_blocks::<Avx8>(first, count, o, d, tmax)
+            // As for nearest hits: SSE lanes for leaves of four or fewer.
+            if count <= 4 {
+                g.leaf_blocks::<super::lanes::Sse4>(first, count, o, d, tmax)
+            } else {
+                g.leaf_blocks::<Avx8>(first, count, o, d, tmax)
+            }
         }
         // SAFETY: the processor has AVX (this function's contract).
         self.occluded_bvh_with::<Avx8>(bvh, origin, dir, tmax, |first, count| unsafe {
