@@ -116,7 +116,10 @@ fn main() {
         let Shape::Mesh { positions, triangles, .. } = &mesh else { unreachable!() };
         for (name, rays) in [("bounce_in.bin", &bounce_in), ("bounce_out.bin", &bounce_out)] {
             let path = std::path::Path::new(&dir).join(name);
-            std::fs::write(&path, ray_file(positions, triangles, rays)).expect("writing the rays");
+            if let Err(e) = std::fs::write(&path, ray_file(positions, triangles, rays)) {
+                eprintln!("error: cannot write {}: {e}", path.display());
+                std::process::exit(1);
+            }
             println!("wrote {} ({} rays)", path.display(), rays.len());
         }
         return;

@@ -1,6 +1,7 @@
 //! One ray through the BVH: its nearest hit and whether anything blocks
 //! it, with the box tests and a leaf's triangles in SIMD lanes (eight at a
-//! time where the processor has AVX, found at run time; without it, boxes
+//! time where the processor has AVX, found at run time, and a leaf of four
+//! triangles or fewer four at a time with SSE; without AVX, boxes
 //! and nearest hits four at a time with SSE and shadow rays' triangles one
 //! by one; a portable loop for tests). Every lane type does the same IEEE
 //! operations as the one-triangle functions, so the answers do not depend
@@ -57,8 +58,8 @@ impl Geometry {
         // lanes go through a function of its own that has it.
         #[target_feature(enable = "avx")]
         unsafe fn leaf(g: &Geometry, first: u32, count: u32, o: Vec3, d: Vec3, best: (f32, u32)) -> Option<(f32, u32)> {
-            // Most leaves hold four triangles or fewer: SSE lanes then
-            // gather and compute half as much as AVX ones (the same IEEE
+            // A leaf of four triangles or fewer fits SSE lanes, which
+            // gather and compute half what AVX ones do (the same IEEE
             // operations, so the same hits).
             if count <= 4 {
                 g.leaf_nearest::<super::lanes::Sse4>(first, count, o, d, best)
