@@ -5,6 +5,7 @@
 //! `one_ray.rs`, packets' in `batch.rs` and `packet.rs`.
 
 use super::Ray;
+use super::blocks::{TriangleBlock, into_blocks};
 use super::bvh::Bvh8;
 use super::lanes::LaneWidth;
 use super::records::{
@@ -71,9 +72,9 @@ pub struct Geometry {
     records: Vec<Record>,
     planes: Vec<PlaneRecord>,
     unbounded: Vec<UnboundedSdf>,
-    /// Each record's triangle as (v0, e1, e2), zeros for other primitives:
-    /// the compact copy that traversal reads, one 36-byte entry per record.
-    pub(super) triangles: Vec<[Vec3; 3]>,
+    /// The triangles of the tree's leaves of triangles alone, in blocks of
+    /// four (the compact copy that traversal reads; empty without a tree).
+    pub(super) blocks: Vec<TriangleBlock>,
     /// None when there are few primitives: testing them all is faster.
     bvh: Option<Bvh8>,
     /// A small scene of quads and a few other primitives, tested all at
@@ -181,8 +182,16 @@ impl GeometryBuilder {
         let bounds = records.iter().map(|r| r.prim.bounds()).reduce(|a, b| a.union(&b));
         let bounds = bounds.map(|b| (Vec3::from(b.min), Vec3::from(b.max)));
         if records.len() <= LINEAR_LIMIT {
-            let triangles = triangles_of(&records);
-            return Geometry { records, planes, unbounded, triangles, bvh: None, small: None, bounds, triangle_uvs };
+            return Geometry {
+                records,
+                planes,
+                unbounded,
+                blocks: Vec::new(),
+                bvh: None,
+                small: None,
+                bounds,
+                triangle_uvs,
+            };
         }
         let mut params = BvhBuildParams::medium_build();
         if records.len() <= SMALL_SCENE {
@@ -195,28 +204,29 @@ impl GeometryBuilder {
         // Reorder so that the tree's leaf ranges index `records` directly.
         let records: Vec<Record> =
             super::pages::collect_in_huge_pages(bvh2.primitive_indices.iter().map(|&i| records[i as usize].clone()));
-        let triangles = triangles_of(&records);
         let mixed = |first: u32, count: u32| {
             records[first as usize..(first + count) as usize].iter().any(|r| !matches!(r.prim, Prim::Triangle { .. }))
         };
-        let bvh = Bvh8::from_bvh2(&bvh2, mixed);
+        let mut bvh = Bvh8::from_bvh2(&bvh2, mixed);
         // Many primitives with the same bounds (duplicated objects or faces)
         // can make the tree deeper than the traversal's fixed stack: such
         // scenes are searched linearly instead, slow but right.
         if bvh.depth() > Bvh8::MAX_DEPTH {
-            return Geometry { records, planes, unbounded, triangles, bvh: None, small: None, bounds, triangle_uvs };
+            return Geometry {
+                records,
+                planes,
+                unbounded,
+                blocks: Vec::new(),
+                bvh: None,
+                small: None,
+                bounds,
+                triangle_uvs,
+            };
         }
+        let blocks = into_blocks(&mut bvh, &records);
         let small = small_scene(&records);
-        Geometry { records, planes, unbounded, triangles, bvh: Some(bvh), small, bounds, triangle_uvs }
+        Geometry { records, planes, unbounded, blocks, bvh: Some(bvh), small, bounds, triangle_uvs }
     }
-}
-
-/// The (v0, e1, e2) of every triangle record, zeros for other primitives.
-fn triangles_of(records: &[Record]) -> Vec<[Vec3; 3]> {
-    super::pages::collect_in_huge_pages(records.iter().map(|r| match r.prim {
-        Prim::Triangle { v0, e1, e2 } => [v0, e1, e2],
-        _ => [Vec3::ZERO; 3],
-    }))
 }
 
 impl Geometry {

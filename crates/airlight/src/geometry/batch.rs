@@ -5,6 +5,7 @@
 //! blocked or not.
 
 use super::accel::Geometry;
+use super::blocks::{TriangleBlock, blocks_of};
 #[cfg(target_arch = "x86_64")]
 use super::lanes::{Avx8, Avx16};
 use super::lanes::{LaneWidth, Lanes, NativeLanes, Scalar4};
@@ -249,15 +250,34 @@ impl Geometry {
         );
     }
 
-    /// Starts fetching the compact copies of triangles `first .. first + count`.
+    /// Starts fetching the blocks of a leaf of `count` triangles from
+    /// block `first`. (A leaf with other primitives links to its first
+    /// primitive instead: the fetch is then of the wrong memory, harmless.)
     #[inline(always)]
     pub(super) fn prefetch_triangles(&self, first: u32, count: u32) {
-        if let Some(t) = self.triangles.get(first as usize..(first + count) as usize) {
-            super::packet::prefetch(&t[0]);
-            if let Some(last) = t.last() {
-                super::packet::prefetch(last);
+        let end = (first as usize + blocks_of(count)).min(self.blocks.len());
+        if let Some(blocks) = self.blocks.get(first as usize..end) {
+            for block in blocks.iter().take(2) {
+                super::packet::prefetch(block);
             }
         }
+    }
+
+    /// The blocks of a leaf of `count` triangles from block `first`.
+    #[inline(always)]
+    pub(super) fn blocks_of_leaf(&self, first: u32, count: u32) -> &[TriangleBlock] {
+        &self.blocks[first as usize..first as usize + blocks_of(count)]
+    }
+
+    /// The (primitive, [v0, e1, e2]) of a leaf of `count` triangles from
+    /// block `first`, in the leaf's order.
+    #[inline(always)]
+    pub(super) fn leaf_triangles(&self, first: u32, count: u32) -> impl Iterator<Item = (u32, [Vec3; 3])> + '_ {
+        let blocks = self.blocks_of_leaf(first, count);
+        (0..count as usize).map(move |k| {
+            let block = &blocks[k / 4];
+            (block.ids[k % 4], block.triangle(k % 4))
+        })
     }
 
     /// A leaf of a nearest-hit packet query: tests primitives `first ..
@@ -278,8 +298,8 @@ impl Geometry {
             }
             return;
         }
-        for i in first..first + count {
-            let triangle = &self.triangles[i as usize];
+        for (i, triangle) in self.leaf_triangles(first, count) {
+            let triangle = &triangle;
             for (s, lanes) in groups::<L>(rays) {
                 let (hit, t) = p.triangle_lanes::<L>(s, triangle);
                 let tmax = L::load(&p.tmax[s..]);
@@ -314,8 +334,8 @@ impl Geometry {
             }
             return blocked;
         }
-        for i in first..first + count {
-            let triangle = &self.triangles[i as usize];
+        for (_, triangle) in self.leaf_triangles(first, count) {
+            let triangle = &triangle;
             for (s, lanes) in groups::<L>(rays & !blocked) {
                 blocked |= ((p.triangle_blocks_lanes::<L>(s, triangle) & lanes) as u64) << s;
             }

@@ -253,6 +253,29 @@ impl<const W: usize> Bvh<W> {
         Bvh { nodes, depth }
     }
 
+    /// The (first primitive, count) of every leaf of triangles alone (not
+    /// marked [`LEAF_MIXED`]), in the order the nodes are laid out.
+    pub(super) fn triangle_leaves(&self) -> impl Iterator<Item = (u32, u32)> + '_ {
+        self.nodes.iter().flat_map(|node| {
+            (0..W)
+                .filter(|&c| node.count[c] != 0 && node.count[c] & LEAF_MIXED == 0)
+                .map(|c| (node.child[c], node.count[c]))
+        })
+    }
+
+    /// Links every leaf of triangles alone to `link(first, count)` in place
+    /// of its first primitive, leaves in the order of
+    /// [`Bvh::triangle_leaves`].
+    pub(super) fn relink_triangle_leaves(&mut self, mut link: impl FnMut(u32, u32) -> u32) {
+        for node in &mut self.nodes {
+            for c in 0..W {
+                if node.count[c] != 0 && node.count[c] & LEAF_MIXED == 0 {
+                    node.child[c] = link(node.child[c], node.count[c]);
+                }
+            }
+        }
+    }
+
     /// Levels of nodes, the root's included.
     pub fn depth(&self) -> usize {
         self.depth

@@ -7,6 +7,8 @@
 //! operation is a single IEEE operation per lane (no fused multiply-add),
 //! so the four give the same bits.
 
+use super::blocks::TriangleBlock;
+
 /// `WIDTH` f32 lanes and the operations the traversal needs. Comparisons
 /// give a mask (bit i for lane i) and, like Rust's scalar comparisons, are
 /// false when either side is NaN.
@@ -37,22 +39,18 @@ pub trait Lanes: Copy {
     fn le(self, o: Self) -> u32;
     fn eq(self, o: Self) -> u32;
 
-    /// Triangles' stored (v0, e1, e2) in lanes, lane k from `group[k]`, and
-    /// the lanes past the group's end repeating its last triangle (whose
-    /// answers the caller drops): 1 to `WIDTH` triangles. SSE and AVX lanes
-    /// transpose in registers: filling an array, as here, and loading it as
-    /// vectors waits on store forwarding, and one-ray queries ran
-    /// 1.09–1.35× as fast without it on a 1.1 M-triangle mesh
-    /// (BENCHMARKS.md).
+    /// Triangles' (v0, e1, e2) in lanes from blocks of four: lane k from
+    /// lane k % 4 of `blocks[k / 4]`, the lanes past the blocks given
+    /// repeating the last block (whose answers the caller drops): 1 to
+    /// `WIDTH / 4` blocks (one for `WIDTH` 4, or where fewer are given).
+    /// SSE and AVX lanes load the blocks' rows as they are.
     #[inline(always)]
-    fn triangles(group: &[[glam::Vec3; 3]]) -> [[Self; 3]; 3] {
+    fn triangle_lanes(blocks: &[TriangleBlock]) -> [[Self; 3]; 3] {
         let mut rows = [[0.0f32; 16]; 9];
         for k in 0..Self::WIDTH {
-            let triangle = &group[k.min(group.len() - 1)];
-            for (v, vector) in triangle.iter().enumerate() {
-                rows[3 * v][k] = vector.x;
-                rows[3 * v + 1][k] = vector.y;
-                rows[3 * v + 2][k] = vector.z;
+            let block = &blocks[(k / 4).min(blocks.len() - 1)];
+            for (row, lanes) in rows.iter_mut().zip(&block.rows) {
+                row[k] = lanes[k % 4];
             }
         }
         // Written out rather than built by closures, which are compiled
@@ -277,26 +275,30 @@ mod tests {
         triangles_in_lanes::<L>();
     }
 
-    /// Triangles into lanes: every float moved bit for bit, lanes past a
-    /// group's end repeating its last triangle, for every group size.
+    /// Triangles into lanes: every float moved bit for bit, lanes past
+    /// the blocks given repeating the last block, for every block count.
     fn triangles_in_lanes<L: Lanes>() {
-        let float = |k: usize, v: usize, a: usize| match (k + v + a) % 5 {
-            0 => VALUES[(k + 3 * v + a) % 8],
-            _ => (100 * k + 10 * v + a) as f32 + 0.25,
+        let float = |k: usize, row: usize| match (k + row) % 5 {
+            0 => VALUES[(k + 3 * row) % 8],
+            _ => (100 * k + row) as f32 + 0.25,
         };
-        let all: Vec<[glam::Vec3; 3]> = (0..L::WIDTH)
-            .map(|k| std::array::from_fn(|v| glam::Vec3::new(float(k, v, 0), float(k, v, 1), float(k, v, 2))))
+        let blocks: Vec<TriangleBlock> = (0..L::WIDTH.div_ceil(4))
+            .map(|b| TriangleBlock {
+                rows: std::array::from_fn(|row| std::array::from_fn(|k| float(4 * b + k, row))),
+                ids: [0; 4],
+            })
             .collect();
-        for len in 1..=L::WIDTH {
-            let lanes = L::triangles(&all[..len]);
+        for len in 1..=blocks.len() {
+            let lanes = L::triangle_lanes(&blocks[..len]);
             for (v, vector) in lanes.iter().enumerate() {
                 for (a, axis) in vector.iter().enumerate() {
                     for k in 0..L::WIDTH {
-                        let want = float(k.min(len - 1), v, a);
+                        let block = (k / 4).min(len - 1);
+                        let want = float(4 * block + k % 4, 3 * v + a);
                         assert_eq!(
                             axis.to_array()[k].to_bits(),
                             want.to_bits(),
-                            "{len} triangles: lane {k}, vector {v}, axis {a}"
+                            "{len} blocks: lane {k}, vector {v}, axis {a}"
                         );
                     }
                 }

@@ -2,6 +2,7 @@
 
 mod accel;
 mod batch;
+mod blocks;
 mod box_lanes;
 mod bvh;
 mod lanes;

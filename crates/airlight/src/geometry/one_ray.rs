@@ -146,21 +146,21 @@ impl Geometry {
         })
     }
 
-    /// Whether a triangle of the leaf blocks the segment, `L::WIDTH` at a
-    /// time, each lane operation for operation as [`triangle_blocks`].
+    /// Whether one of the `count` triangles in blocks from `first` blocks
+    /// the segment, `L::WIDTH` at a time, each lane operation for
+    /// operation as [`triangle_blocks`].
     #[inline(always)]
     fn leaf_blocks<L: Lanes>(&self, first: u32, count: u32, o: Vec3, d: Vec3, tmax: f32) -> bool {
         let (d4, o4) = (splat::<L>(d), splat::<L>(o));
-        let end = first + count;
-        let mut start = first;
-        while start < end {
-            let n = (end - start).min(L::WIDTH as u32) as usize;
-            let [v0, e1, e2] = L::triangles(&self.triangles[start as usize..start as usize + n]);
+        let mut left = count as usize;
+        for group in self.blocks_of_leaf(first, count).chunks(L::WIDTH.div_ceil(4)) {
+            let n = left.min(L::WIDTH);
+            left -= n;
+            let [v0, e1, e2] = L::triangle_lanes(group);
             let blocked = triangle_blocks_mask(triangle_terms(d4, o4, v0, e1, e2), L::splat(tmax));
             if blocked & ((1u32 << n) - 1) != 0 {
                 return true;
             }
-            start += n as u32;
         }
         false
     }
@@ -170,10 +170,7 @@ impl Geometry {
     #[inline(always)]
     pub(super) fn occluded_bvh<B: Lanes>(&self, bvh: &Bvh8, origin: Vec3, dir: Vec3, tmax: f32) -> bool {
         self.occluded_bvh_with::<B>(bvh, origin, dir, tmax, |first, count| {
-            (first..first + count).any(|i| {
-                let [v0, e1, e2] = self.triangles[i as usize];
-                triangle_blocks(v0, e1, e2, origin, dir, tmax)
-            })
+            self.leaf_triangles(first, count).any(|(_, [v0, e1, e2])| triangle_blocks(v0, e1, e2, origin, dir, tmax))
         })
     }
 
@@ -195,10 +192,11 @@ impl Geometry {
         })
     }
 
-    /// Of triangles `first .. first + count` (a leaf of triangles only), the
-    /// nearest hit that comes before `best` (as [`comes_before`] orders
-    /// them), if any: `L::WIDTH` triangles at a time in SIMD lanes, each lane
-    /// operation for operation as [`intersect_triangle`](super::intersect_triangle), and the lanes'
+    /// Of the `count` triangles in blocks from `first` (a leaf of
+    /// triangles alone), the nearest hit that comes before `best` (as
+    /// [`comes_before`] orders them), if any: `L::WIDTH` triangles at a
+    /// time in SIMD lanes, each lane operation for operation as
+    /// [`intersect_triangle`](super::intersect_triangle), and the lanes'
     /// hits then taken in index order against the bound the one-triangle
     /// loop would use, so that the answer is that loop's, bit for bit. A
     /// ray across the inside of a 1.1 M-triangle mesh tests about 19
@@ -208,24 +206,23 @@ impl Geometry {
         let (mut best_t, mut best_id) = best;
         let mut found = None;
         let (d4, o4) = (splat::<L>(d), splat::<L>(o));
-        let end = first + count;
-        let mut start = first;
-        while start < end {
-            let n = (end - start).min(L::WIDTH as u32) as usize;
-            let [v0, e1, e2] = L::triangles(&self.triangles[start as usize..start as usize + n]);
+        let mut left = count as usize;
+        for group in self.blocks_of_leaf(first, count).chunks(L::WIDTH.div_ceil(4)) {
+            let n = left.min(L::WIDTH);
+            left -= n;
+            let [v0, e1, e2] = L::triangle_lanes(group);
             let (hits, t) = triangle_hits(triangle_terms(d4, o4, v0, e1, e2));
             let t = t.to_array();
             let mut m = hits & ((1u32 << n) - 1);
             while m != 0 {
                 let k = m.trailing_zeros() as usize;
                 m &= m - 1;
-                let (t, i) = (t[k], start + k as u32);
+                let (t, i) = (t[k], group[k / 4].ids[k % 4]);
                 if t < test_bound(best_t, best_id) && comes_before(t, i, best_t, best_id) {
                     (best_t, best_id) = (t, i);
                     found = Some((t, i));
                 }
             }
-            start += n as u32;
         }
         found
     }

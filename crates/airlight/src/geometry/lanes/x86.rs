@@ -1,76 +1,25 @@
 //! The x86-64 lanes: four in an SSE register (the x86-64 baseline),
 //! eight with AVX and sixteen with AVX-512 (each used only after the
-//! processor is found to have it), and triangles transposed into them.
+//! processor is found to have it), and triangles loaded into them from
+//! blocks of four.
 
 use super::Lanes;
+use crate::geometry::blocks::TriangleBlock;
 use std::arch::x86_64::*;
 
-/// Where triangle k of the group (its last for k past the end) starts:
-/// nine f32s, the x, y, z of v0, e1 and e2. Loads of four at 0, 4 and 5
-/// stay within them.
+/// Row `r` of a block in four lanes.
 #[inline(always)]
-fn triangle_floats(group: &[[glam::Vec3; 3]], k: usize) -> *const f32 {
-    const { assert!(std::mem::size_of::<[glam::Vec3; 3]>() == 36) };
-    group[k.min(group.len() - 1)].as_ptr().cast::<f32>()
+fn row4(rows: &[[f32; 4]; 9], r: usize) -> Sse4 {
+    // SAFETY: a row is four f32s, 16-byte aligned (a block is 32-byte
+    // aligned and a row 16 bytes); SSE is part of the x86-64 baseline.
+    unsafe { Sse4(_mm_load_ps(rows[r].as_ptr())) }
 }
 
-/// Four floats from `at` of each triangle.
+/// Row `r` of two blocks in eight lanes, the first block's in the low
+/// half.
 #[inline(always)]
-unsafe fn rows4(t: &[*const f32; 4], at: usize) -> [__m128; 4] {
-    unsafe {
-        [_mm_loadu_ps(t[0].add(at)), _mm_loadu_ps(t[1].add(at)), _mm_loadu_ps(t[2].add(at)), _mm_loadu_ps(t[3].add(at))]
-    }
-}
-
-/// The 4×4 transpose: lane k of output j is lane j of input k.
-#[inline(always)]
-unsafe fn transpose4([r0, r1, r2, r3]: [__m128; 4]) -> [__m128; 4] {
-    unsafe {
-        let (t0, t1) = (_mm_unpacklo_ps(r0, r1), _mm_unpacklo_ps(r2, r3));
-        let (t2, t3) = (_mm_unpackhi_ps(r0, r1), _mm_unpackhi_ps(r2, r3));
-        [_mm_movelh_ps(t0, t1), _mm_movehl_ps(t1, t0), _mm_movelh_ps(t2, t3), _mm_movehl_ps(t3, t2)]
-    }
-}
-
-/// Lane 3 of each input, in order.
-#[inline(always)]
-unsafe fn fourth4([r0, r1, r2, r3]: [__m128; 4]) -> __m128 {
-    unsafe { _mm_movehl_ps(_mm_unpackhi_ps(r2, r3), _mm_unpackhi_ps(r0, r1)) }
-}
-
-/// Four floats from `at` of triangles k (low half) and k + 4 (high
-/// half), for k = 0..4.
-#[inline(always)]
-unsafe fn rows8(t: &[*const f32; 8], at: usize) -> [__m256; 4] {
-    unsafe {
-        [
-            _mm256_loadu2_m128(t[4].add(at), t[0].add(at)),
-            _mm256_loadu2_m128(t[5].add(at), t[1].add(at)),
-            _mm256_loadu2_m128(t[6].add(at), t[2].add(at)),
-            _mm256_loadu2_m128(t[7].add(at), t[3].add(at)),
-        ]
-    }
-}
-
-/// [`transpose4`] in each 128-bit half.
-#[inline(always)]
-unsafe fn transpose8([r0, r1, r2, r3]: [__m256; 4]) -> [__m256; 4] {
-    unsafe {
-        let (t0, t1) = (_mm256_unpacklo_ps(r0, r1), _mm256_unpacklo_ps(r2, r3));
-        let (t2, t3) = (_mm256_unpackhi_ps(r0, r1), _mm256_unpackhi_ps(r2, r3));
-        [
-            _mm256_shuffle_ps::<0b01_00_01_00>(t0, t1),
-            _mm256_shuffle_ps::<0b11_10_11_10>(t0, t1),
-            _mm256_shuffle_ps::<0b01_00_01_00>(t2, t3),
-            _mm256_shuffle_ps::<0b11_10_11_10>(t2, t3),
-        ]
-    }
-}
-
-/// [`fourth4`] in each 128-bit half.
-#[inline(always)]
-unsafe fn fourth8([r0, r1, r2, r3]: [__m256; 4]) -> __m256 {
-    unsafe { _mm256_shuffle_ps::<0b11_10_11_10>(_mm256_unpackhi_ps(r0, r1), _mm256_unpackhi_ps(r2, r3)) }
+unsafe fn row8(low: &[[f32; 4]; 9], high: &[[f32; 4]; 9], r: usize) -> Avx8 {
+    unsafe { Avx8(_mm256_loadu2_m128(high[r].as_ptr(), low[r].as_ptr())) }
 }
 
 /// Four lanes in an SSE register.
@@ -85,21 +34,13 @@ impl Lanes for Sse4 {
     type Four = Sse4;
     type Array = [f32; 4];
     #[inline(always)]
-    fn triangles(group: &[[glam::Vec3; 3]]) -> [[Self; 3]; 3] {
-        let t = [
-            triangle_floats(group, 0),
-            triangle_floats(group, 1),
-            triangle_floats(group, 2),
-            triangle_floats(group, 3),
-        ];
-        // SAFETY: SSE is part of the x86-64 baseline; each load reads
-        // four of a triangle's nine floats (`triangle_floats`).
-        unsafe {
-            let [v0x, v0y, v0z, e1x] = transpose4(rows4(&t, 0));
-            let [e1y, e1z, e2x, e2y] = transpose4(rows4(&t, 4));
-            let e2z = fourth4(rows4(&t, 5));
-            [[Sse4(v0x), Sse4(v0y), Sse4(v0z)], [Sse4(e1x), Sse4(e1y), Sse4(e1z)], [Sse4(e2x), Sse4(e2y), Sse4(e2z)]]
-        }
+    fn triangle_lanes(blocks: &[TriangleBlock]) -> [[Self; 3]; 3] {
+        let r = &blocks[0].rows;
+        [
+            [row4(r, 0), row4(r, 1), row4(r, 2)],
+            [row4(r, 3), row4(r, 4), row4(r, 5)],
+            [row4(r, 6), row4(r, 7), row4(r, 8)],
+        ]
     }
     #[inline(always)]
     fn splat(x: f32) -> Self {
@@ -185,26 +126,18 @@ impl Lanes for Avx8 {
     type Four = Sse4;
     type Array = [f32; 8];
     #[inline(always)]
-    fn triangles(group: &[[glam::Vec3; 3]]) -> [[Self; 3]; 3] {
-        // No closures here: a closure is compiled without the AVX of the
+    fn triangle_lanes(blocks: &[TriangleBlock]) -> [[Self; 3]; 3] {
+        let low = &blocks[0].rows;
+        let high = &blocks[blocks.len().min(2) - 1].rows;
+        // SAFETY: as for every `Avx8` function; each row is four f32s.
+        // No closure here: a closure is compiled without the AVX of the
         // function it is inlined into.
-        let t = [
-            triangle_floats(group, 0),
-            triangle_floats(group, 1),
-            triangle_floats(group, 2),
-            triangle_floats(group, 3),
-            triangle_floats(group, 4),
-            triangle_floats(group, 5),
-            triangle_floats(group, 6),
-            triangle_floats(group, 7),
-        ];
-        // SAFETY: as for every `Avx8` function; each load reads four of a
-        // triangle's nine floats (`triangle_floats`).
         unsafe {
-            let [v0x, v0y, v0z, e1x] = transpose8(rows8(&t, 0));
-            let [e1y, e1z, e2x, e2y] = transpose8(rows8(&t, 4));
-            let e2z = fourth8(rows8(&t, 5));
-            [[Avx8(v0x), Avx8(v0y), Avx8(v0z)], [Avx8(e1x), Avx8(e1y), Avx8(e1z)], [Avx8(e2x), Avx8(e2y), Avx8(e2z)]]
+            [
+                [row8(low, high, 0), row8(low, high, 1), row8(low, high, 2)],
+                [row8(low, high, 3), row8(low, high, 4), row8(low, high, 5)],
+                [row8(low, high, 6), row8(low, high, 7), row8(low, high, 8)],
+            ]
         }
     }
     #[inline(always)]
