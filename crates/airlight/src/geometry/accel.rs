@@ -181,17 +181,9 @@ impl GeometryBuilder {
         let GeometryBuilder { records, planes, unbounded, triangle_uvs } = self;
         let bounds = records.iter().map(|r| r.prim.bounds()).reduce(|a, b| a.union(&b));
         let bounds = bounds.map(|b| (Vec3::from(b.min), Vec3::from(b.max)));
+        // Without a tree, every primitive is tested for every ray.
         if records.len() <= LINEAR_LIMIT {
-            return Geometry {
-                records,
-                planes,
-                unbounded,
-                blocks: Vec::new(),
-                bvh: None,
-                small: None,
-                bounds,
-                triangle_uvs,
-            };
+            return Geometry { records, planes, unbounded, bounds, triangle_uvs, ..Geometry::default() };
         }
         let mut params = BvhBuildParams::medium_build();
         if records.len() <= SMALL_SCENE {
@@ -212,16 +204,7 @@ impl GeometryBuilder {
         // can make the tree deeper than the traversal's fixed stack: such
         // scenes are searched linearly instead, slow but right.
         if bvh.depth() > Bvh8::MAX_DEPTH {
-            return Geometry {
-                records,
-                planes,
-                unbounded,
-                blocks: Vec::new(),
-                bvh: None,
-                small: None,
-                bounds,
-                triangle_uvs,
-            };
+            return Geometry { records, planes, unbounded, bounds, triangle_uvs, ..Geometry::default() };
         }
         let blocks = into_blocks(&mut bvh, &records);
         let small = small_scene(&records);

@@ -23,9 +23,11 @@ use super::lanes::Lanes;
 use obvhs::bvh2::Bvh2;
 
 /// W children's boxes and links. A child slot is a leaf if its count is
-/// non-zero (`child` is then the first primitive, `count & COUNT_MASK` the
-/// number of primitives), an inner node if its count is zero, and empty if
-/// its box is empty (min = +∞, max = −∞, which no ray hits).
+/// non-zero (`child` is then the first primitive, or the first block of a
+/// leaf of triangles alone once [`Bvh::relink_triangle_leaves`] has
+/// linked it, and `count & COUNT_MASK` the number of primitives), an inner
+/// node if its count is zero, and empty if its box is empty (min = +∞,
+/// max = −∞, which no ray hits).
 #[derive(Clone, Copy, Debug)]
 #[repr(C, align(64))]
 pub(super) struct Node<const W: usize> {
@@ -60,7 +62,7 @@ impl<const W: usize> Node<W> {
 }
 
 /// The flattened tree. Primitive indices in leaves are positions in the
-/// obvhs tree's `primitive_indices` order.
+/// obvhs tree's `primitive_indices` order (until leaves are relinked).
 #[derive(Clone, Debug)]
 pub struct Bvh<const W: usize> {
     pub(super) nodes: Vec<Node<W>>,
