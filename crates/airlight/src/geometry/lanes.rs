@@ -39,11 +39,10 @@ pub trait Lanes: Copy {
     fn le(self, o: Self) -> u32;
     fn eq(self, o: Self) -> u32;
 
-    /// Triangles' (v0, e1, e2) in lanes from blocks of four: lane k from
-    /// lane k % 4 of `blocks[k / 4]`, the lanes past the blocks given
-    /// repeating the last block (whose answers the caller drops): 1 to
-    /// `WIDTH / 4` blocks (one for `WIDTH` 4, or where fewer are given).
-    /// SSE and AVX lanes load the blocks' rows as they are.
+    /// Triangles' (v0, e1, e2) in lanes from 1 to `WIDTH / 4` blocks of
+    /// four: lane k from lane k % 4 of `blocks[k / 4]`, and the lanes past
+    /// the blocks given repeating the last block (the caller drops their
+    /// answers). SSE and AVX lanes load the blocks' rows as they are.
     #[inline(always)]
     fn triangle_lanes(blocks: &[TriangleBlock]) -> [[Self; 3]; 3] {
         let mut rows = [[0.0f32; 16]; 9];

@@ -59,7 +59,7 @@ impl Geometry {
         #[target_feature(enable = "avx")]
         unsafe fn leaf(g: &Geometry, first: u32, count: u32, o: Vec3, d: Vec3, best: (f32, u32)) -> Option<(f32, u32)> {
             // A leaf of four triangles or fewer fits SSE lanes, which
-            // gather and compute half what AVX ones do (the same IEEE
+            // load and compute half what AVX ones do (the same IEEE
             // operations, so the same hits).
             if count <= 4 {
                 g.leaf_nearest::<super::lanes::Sse4>(first, count, o, d, best)
