@@ -97,9 +97,9 @@ def test_an_exception_in_the_progress_callback_stops_the_render():
 CHILD = textwrap.dedent(
     """
     import signal, sys, time, airlight
-    # Python leaves SIGINT ignored where it started so (a job started in
-    # the background by a shell without job control): Ctrl-C's handler
-    # is set here, or the signal would not reach the render.
+    # A Python started with SIGINT ignored (a background job of a shell
+    # without job control) installs no Ctrl-C handler: it is set here,
+    # or the signal would not reach the render.
     signal.signal(signal.SIGINT, signal.default_int_handler)
     scene = airlight.load(sys.argv[1])
     started = False

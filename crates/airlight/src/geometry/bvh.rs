@@ -259,9 +259,7 @@ impl<const W: usize> Bvh<W> {
     /// marked [`LEAF_MIXED`]), in the order the nodes are laid out.
     pub(super) fn triangle_leaves(&self) -> impl Iterator<Item = (u32, u32)> + '_ {
         self.nodes.iter().flat_map(|node| {
-            (0..W)
-                .filter(|&c| node.count[c] != 0 && node.count[c] & LEAF_MIXED == 0)
-                .map(|c| (node.child[c], node.count[c]))
+            (0..W).filter(|&c| is_triangle_leaf(node.count[c])).map(|c| (node.child[c], node.count[c]))
         })
     }
 
@@ -271,7 +269,7 @@ impl<const W: usize> Bvh<W> {
     pub(super) fn relink_triangle_leaves(&mut self, mut link: impl FnMut(u32, u32) -> u32) {
         for node in &mut self.nodes {
             for c in 0..W {
-                if node.count[c] != 0 && node.count[c] & LEAF_MIXED == 0 {
+                if is_triangle_leaf(node.count[c]) {
                     node.child[c] = link(node.child[c], node.count[c]);
                 }
             }
@@ -407,6 +405,11 @@ impl<const W: usize> Bvh<W> {
         }
         false
     }
+}
+
+/// Whether a child slot's count is that of a leaf of triangles alone.
+fn is_triangle_leaf(count: u32) -> bool {
+    count != 0 && count & LEAF_MIXED == 0
 }
 
 fn area(bvh2: &Bvh2, node: usize) -> f32 {

@@ -17,6 +17,9 @@ fn row4(rows: &[[f32; 4]; 9], r: usize) -> Sse4 {
 
 /// Row `r` of two blocks in eight lanes, the first block's in the low
 /// half.
+///
+/// # Safety
+/// The processor must have AVX (the contract of every [`Avx8`]).
 #[inline(always)]
 unsafe fn row8(low: &[[f32; 4]; 9], high: &[[f32; 4]; 9], r: usize) -> Avx8 {
     unsafe { Avx8(_mm256_loadu2_m128(high[r].as_ptr(), low[r].as_ptr())) }
