@@ -76,6 +76,9 @@ fn main() {
         generated.as_secs_f64(),
         build.as_secs_f64()
     );
+    if let Some(shape) = geometry.tree_shape() {
+        println!("tree: {shape}");
+    }
 
     let (w, h) = (1024u32, 1024u32);
     let camera = Camera::look_at(vec3(0.0, 0.6, -3.2), Vec3::ZERO, Vec3::Y, 40.0);

@@ -1,8 +1,7 @@
-//! A wide BVH traversed with SIMD box tests: obvhs builds a binary tree
-//! (PLOC, reinsertion, SAH leaf collapse), which is flattened here into nodes
-//! of eight children whose boxes are stored as structure of arrays, so that
-//! one node is four cache lines and its eight slab tests are a handful of
-//! AVX instructions (or twice as many SSE ones where the processor has no
+//! A wide BVH traversed with SIMD box tests: nodes of eight children (made
+//! from obvhs's binary tree in `collapse.rs`) whose boxes are stored as
+//! structure of arrays, so that one node is four cache lines and its eight
+//! slab tests are a handful of AVX instructions (or twice as many SSE ones where the processor has no
 //! AVX; every lane type does the same IEEE operations, so the hits do not
 //! depend on the processor).
 //!
@@ -20,7 +19,6 @@
 //! quantised child boxes one by one (BENCHMARKS.md has the figures).
 
 use super::lanes::Lanes;
-use obvhs::bvh2::Bvh2;
 
 /// W children's boxes and links. A child slot is a leaf if its count is
 /// non-zero (`child` is then the first primitive, or the first block of a
@@ -47,7 +45,7 @@ pub(super) const COUNT_MASK: u32 = !LEAF_MIXED;
 pub(super) const STACK_SIZE: usize = 256;
 
 impl<const W: usize> Node<W> {
-    const EMPTY: Self = Node {
+    pub(super) const EMPTY: Self = Node {
         bounds: [
             [f32::INFINITY; W],
             [f32::INFINITY; W],
@@ -61,12 +59,12 @@ impl<const W: usize> Node<W> {
     };
 }
 
-/// The flattened tree. Primitive indices in leaves are positions in the
-/// obvhs tree's `primitive_indices` order (until leaves are relinked).
+/// The wide tree. Primitive indices in leaves are positions in the order
+/// the collapse returns with it (until leaves are relinked to blocks).
 #[derive(Clone, Debug)]
 pub struct Bvh<const W: usize> {
     pub(super) nodes: Vec<Node<W>>,
-    depth: usize,
+    pub(super) depth: usize,
 }
 
 /// The tree the geometry uses: eight children a node.
@@ -191,69 +189,6 @@ impl Stack {
 impl<const W: usize> Bvh<W> {
     /// The deepest tree the traversal stack can hold.
     pub const MAX_DEPTH: usize = (STACK_SIZE - 1) / (W - 1);
-
-    /// Flattens an obvhs binary tree. Each node takes the two children of a
-    /// binary node and then repeatedly splits its largest inner child into
-    /// that child's two children, until it has W. Nodes are laid out
-    /// depth first (a node, then the whole subtree of its first inner
-    /// child, then of its second, …): against siblings side by side,
-    /// incoherent rays out of a 1.1 M-triangle mesh ran 1.12× as fast and
-    /// rays across its inside 1.05× (bench_bvh, 4 side-by-side pairs each,
-    /// measured on four-wide trees), with the same tree and so the same hits.
-    pub fn from_bvh2(bvh2: &Bvh2, mixed: impl Fn(u32, u32) -> bool) -> Self {
-        let mut nodes = super::pages::vec_in_huge_pages(bvh2.nodes.len() / (2 * (W - 1)) + 1);
-        nodes.push(Node::EMPTY);
-        let root = &bvh2.nodes[0];
-        let mut depth = 1;
-        if root.is_leaf() {
-            set_child(&mut nodes[0], 0, bvh2, 0, u32::MAX, &mixed);
-        } else {
-            // Depth first, each node placed right after its parent's slot
-            // is filled: (bvh2 node, the parent's node and child slot that
-            // link to it, level).
-            let mut work = vec![(0usize, None::<(usize, usize)>, 1usize)];
-            while let Some((b2, parent, level)) = work.pop() {
-                depth = depth.max(level);
-                let slot = match parent {
-                    None => 0,
-                    Some((p, c)) => {
-                        nodes.push(Node::EMPTY);
-                        let index = nodes.len() - 1;
-                        nodes[p].child[c] = index as u32;
-                        index
-                    }
-                };
-                let mut kids: Vec<usize> = {
-                    let f = bvh2.nodes[b2].first_index as usize;
-                    vec![f, f + 1]
-                };
-                while kids.len() < W {
-                    let widest = kids
-                        .iter()
-                        .enumerate()
-                        .filter(|(_, k)| !bvh2.nodes[**k].is_leaf())
-                        .max_by(|a, b| area(bvh2, *a.1).total_cmp(&area(bvh2, *b.1)))
-                        .map(|(i, _)| i);
-                    let Some(i) = widest else { break };
-                    let f = bvh2.nodes[kids[i]].first_index as usize;
-                    kids[i] = f;
-                    kids.insert(i + 1, f + 1);
-                }
-                // Pushed last to first, so that the first child is placed next.
-                for (c, &k) in kids.iter().enumerate().rev() {
-                    if bvh2.nodes[k].is_leaf() {
-                        set_child(&mut nodes[slot], c, bvh2, k, u32::MAX, &mixed);
-                    } else {
-                        set_child(&mut nodes[slot], c, bvh2, k, 0, &mixed);
-                        work.push((k, Some((slot, c)), level + 1));
-                    }
-                }
-            }
-        }
-        // The node count was estimated: nodes past the estimate moved.
-        super::pages::move_to_huge_pages(&nodes);
-        Bvh { nodes, depth }
-    }
 
     /// The (first primitive, count) of every leaf of triangles alone (not
     /// marked [`LEAF_MIXED`]), in the order the nodes are laid out.
@@ -412,43 +347,15 @@ fn is_triangle_leaf(count: u32) -> bool {
     count != 0 && count & LEAF_MIXED == 0
 }
 
-fn area(bvh2: &Bvh2, node: usize) -> f32 {
-    bvh2.nodes[node].aabb().half_area()
-}
-
-/// Fills child slot `c` of `node` from binary node `k`: an inner child at
-/// `inner`, or (if `inner` is u32::MAX) a leaf.
-fn set_child<const W: usize>(
-    node: &mut Node<W>,
-    c: usize,
-    bvh2: &Bvh2,
-    k: usize,
-    inner: u32,
-    mixed: &impl Fn(u32, u32) -> bool,
-) {
-    let b = bvh2.nodes[k].aabb();
-    for a in 0..3 {
-        node.bounds[a][c] = b.min[a];
-        node.bounds[a + 3][c] = b.max[a];
-    }
-    let n = &bvh2.nodes[k];
-    if inner == u32::MAX {
-        node.child[c] = n.first_index;
-        let flag = if mixed(n.first_index, n.prim_count) { LEAF_MIXED } else { 0 };
-        node.count[c] = n.prim_count | flag;
-    } else {
-        node.child[c] = inner;
-        node.count[c] = 0;
-    }
-}
-
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use super::*;
     use crate::geometry::batch::comes_before;
+    use crate::geometry::collapse::{CollapseCosts, collapse};
     use crate::geometry::lanes::{NativeLanes, Scalar4};
     use crate::geometry::shape::intersect_triangle;
     use glam::{Vec3, Vec3A};
+    use obvhs::bvh2::Bvh2;
     use obvhs::{BvhBuildParams, triangle::Triangle};
     use std::time::Duration;
 
@@ -460,29 +367,22 @@ mod tests {
         (*state >> 8) as f32 / (1u32 << 24) as f32
     }
 
-    /// Small triangles scattered through the unit cube, the binary tree
-    /// over them, and their vertices in the tree's leaf order.
-    fn scene() -> (Bvh2, Vec<[Vec3; 3]>) {
-        let mut state = 0x1234_5678;
+    /// `count` small triangles scattered through the unit cube (drawn from
+    /// `seed`) and the binary tree over them, whose leaves hold at most
+    /// `leaf_size` each.
+    pub(in crate::geometry) fn scene(seed: u32, count: usize, leaf_size: u32) -> (Bvh2, Vec<[Vec3; 3]>) {
+        let mut state = seed;
         let mut point = |scale: f32| Vec3::new(uniform(&mut state), uniform(&mut state), uniform(&mut state)) * scale;
-        let triangles: Vec<Triangle> = (0..1000)
+        let triangles: Vec<Triangle> = (0..count)
             .map(|_| {
                 let v0 = point(1.0);
                 let (a, b) = (point(0.3) - 0.15, point(0.3) - 0.15);
                 Triangle { v0: v0.into(), v1: Vec3A::from(v0 + a), v2: Vec3A::from(v0 + b) }
             })
             .collect();
-        let bvh2 =
-            obvhs::bvh2::builder::build_bvh2(&triangles, BvhBuildParams::medium_build(), &mut Duration::default());
-        let ordered = bvh2
-            .primitive_indices
-            .iter()
-            .map(|&i| {
-                let t = &triangles[i as usize];
-                [t.v0, t.v1, t.v2].map(Vec3::from)
-            })
-            .collect();
-        (bvh2, ordered)
+        let params = BvhBuildParams { max_prims_per_leaf: leaf_size, ..BvhBuildParams::medium_build() };
+        let bvh2 = obvhs::bvh2::builder::build_bvh2(&triangles, params, &mut Duration::default());
+        (bvh2, triangles.iter().map(|t| [t.v0, t.v1, t.v2].map(Vec3::from)).collect())
     }
 
     /// The nearest hit of all triangles on (0, ∞), ties to the lowest index.
@@ -535,7 +435,9 @@ mod tests {
     /// the same nearest hit (distance and triangle) and the same answer to
     /// "is the segment blocked", over rays from inside and around the cube.
     fn check<B: Lanes, const W: usize>(bvh2: &Bvh2, triangles: &[[Vec3; 3]]) -> usize {
-        let bvh = Bvh::<W>::from_bvh2(bvh2, |_, _| false);
+        let (bvh, order) = collapse::<W>(bvh2, |_| true, &CollapseCosts::MESH);
+        let triangles: Vec<_> = order.iter().map(|&i| triangles[i as usize]).collect();
+        let triangles = &triangles[..];
         assert!(bvh.depth() <= Bvh::<W>::MAX_DEPTH);
         let mut state = 0x9e37_79b9;
         let mut hits = 0;
@@ -558,27 +460,31 @@ mod tests {
         hits
     }
 
+    /// Binary trees of one triangle a leaf (as the geometry builds them)
+    /// and of up to eight (whose leaves the collapse keeps whole).
     #[test]
     fn trees_of_four_and_eight_find_what_a_test_of_every_triangle_finds() {
-        let (bvh2, triangles) = scene();
-        let hits = check::<Scalar4, 4>(&bvh2, &triangles);
-        // Enough rays hit and miss for the comparison to mean something.
-        assert!((500..2500).contains(&hits), "{hits} of 3000 rays hit");
-        check::<NativeLanes, 4>(&bvh2, &triangles);
-        check::<Scalar4, 8>(&bvh2, &triangles);
-        check::<NativeLanes, 8>(&bvh2, &triangles);
-        #[cfg(target_arch = "x86_64")]
-        {
-            use crate::geometry::lanes::{Avx8, has_avx};
-            if has_avx() {
-                #[target_feature(enable = "avx")]
-                unsafe fn with_avx(bvh2: &Bvh2, triangles: &[[Vec3; 3]]) {
-                    check::<Avx8, 8>(bvh2, triangles);
+        for leaf_size in [1, 8] {
+            let (bvh2, triangles) = scene(0x1234_5678, 1000, leaf_size);
+            let hits = check::<Scalar4, 4>(&bvh2, &triangles);
+            // Enough rays hit and miss for the comparison to mean something.
+            assert!((500..2500).contains(&hits), "{hits} of 3000 rays hit");
+            check::<NativeLanes, 4>(&bvh2, &triangles);
+            check::<Scalar4, 8>(&bvh2, &triangles);
+            check::<NativeLanes, 8>(&bvh2, &triangles);
+            #[cfg(target_arch = "x86_64")]
+            {
+                use crate::geometry::lanes::{Avx8, has_avx};
+                if has_avx() {
+                    #[target_feature(enable = "avx")]
+                    unsafe fn with_avx(bvh2: &Bvh2, triangles: &[[Vec3; 3]]) {
+                        check::<Avx8, 8>(bvh2, triangles);
+                    }
+                    // SAFETY: the processor has AVX (checked above).
+                    unsafe { with_avx(&bvh2, &triangles) };
+                } else {
+                    eprintln!("AVX lanes skipped: this processor has no AVX");
                 }
-                // SAFETY: the processor has AVX (checked above).
-                unsafe { with_avx(&bvh2, &triangles) };
-            } else {
-                eprintln!("AVX lanes skipped: this processor has no AVX");
             }
         }
     }

@@ -5,6 +5,7 @@ mod batch;
 mod blocks;
 mod box_lanes;
 mod bvh;
+mod collapse;
 mod lanes;
 mod one_ray;
 mod packet;
@@ -18,6 +19,7 @@ mod small;
 
 pub use accel::{Geometry, GeometryBuilder, Hit, SurfaceHit, shadow_rays_traced};
 pub use batch::Segment;
+pub use collapse::TreeShape;
 pub use lanes::LaneWidth;
 pub use ray::{Ray, offset_origin};
 pub use sdf::Sdf;
