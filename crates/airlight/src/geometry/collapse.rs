@@ -9,9 +9,10 @@
 //!
 //! Against obvhs's own leaf collapse (which counts triangles) followed by
 //! filling each wide node by opening its widest inner child, on a
-//! 1.1 M-triangle mesh: 7.44 children a node instead of 4.14, the leaves'
-//! cost in blocks 3.84 instead of 4.64 root areas, and one ray at a time
-//! 1.06–1.11× as fast (BENCHMARKS.md has the figures).
+//! 1.1 M-triangle mesh: 7.44 children a node instead of 4.14, a ray's
+//! expected visits 13.7 nodes and 3.8 blocks instead of 14.2 and 4.6, and
+//! incoherent rays one at a time 1.05–1.09× as fast (BENCHMARKS.md has the
+//! figures).
 
 use super::bvh::{Bvh, COUNT_MASK, LEAF_MIXED, Node};
 use obvhs::bvh2::Bvh2;
@@ -56,9 +57,8 @@ struct Choices<const W: usize> {
     /// `cost[n][i - 1]`: the cheapest forest of at most i roots for node n.
     cost: Vec<[f32; W]>,
     /// `how[n][i - 1]`: for i = 1, [`LEAF`] (always for a binary leaf) or
-    /// [`INNER`]; for i > 1, 0 to
-    /// take the forest of i − 1 roots, or k to give k roots to the first
-    /// child and i − k to the second.
+    /// [`INNER`]; for i > 1, 0 to take the forest of i − 1 roots, or k to
+    /// give k roots to the first child and i − k to the second.
     how: Vec<[u8; W]>,
     /// For an inner node: the first child's share of the W slots.
     split: Vec<u8>,
@@ -165,7 +165,8 @@ fn choose<const W: usize>(bvh2: &Bvh2, is_triangle: &impl Fn(u32) -> bool, costs
         }
         let (l, r) = (node.first_index as usize, node.first_index as usize + 1);
         counts[i] = (counts[l].0 + counts[r].0, counts[l].1 + counts[r].1);
-        // distribute[j]: the cheapest j roots shared between the children.
+        // distribute[j]: the cheapest j + 1 roots shared between the
+        // children, at least one each (so distribute[0] is none).
         let mut distribute = [(f32::INFINITY, 0u8); W];
         for (j, best) in distribute.iter_mut().enumerate().skip(1) {
             for k in 1..=j {
@@ -175,7 +176,6 @@ fn choose<const W: usize>(bvh2: &Bvh2, is_triangle: &impl Fn(u32) -> bool, costs
                 }
             }
         }
-        // (distribute[j] is for j + 1 roots.)
         let (children, split) = distribute[W - 1];
         choices.split[i] = split;
         // An inner node's box tests are the unit of cost.
