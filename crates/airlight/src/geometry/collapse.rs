@@ -92,7 +92,9 @@ pub(super) fn collapse<const W: usize>(
         super::pages::move_to_huge_pages(&wide);
         return (Bvh { nodes: wide, depth: 1 }, order);
     }
-    let choices = choose::<W>(bvh2, &is_triangle, costs);
+    let mut choices = choose::<W>(bvh2, &is_triangle, costs);
+    // The costs are spent; the records' reordering to come needs the room.
+    choices.cost = Vec::new();
     let mut depth = 1;
     let mut roots = Vec::with_capacity(W);
     let mut subtree = Vec::new();
@@ -140,31 +142,39 @@ fn choose<const W: usize>(bvh2: &Bvh2, is_triangle: &impl Fn(u32) -> bool, costs
     let nodes = &bvh2.nodes;
     let n = nodes.len();
     let mut choices = Choices { cost: vec![[0.0; W]; n], how: vec![[0; W]; n], split: vec![0; n] };
-    // Triangles and other primitives under each node.
-    let mut counts = vec![(0u32, 0u32); n];
+    // The triangles under each node, or HAS_OTHERS if a primitive under it
+    // is not one (such a subtree never becomes one leaf). (Four bytes a
+    // node, as the order below: the build's peak memory is in these.)
+    const HAS_OTHERS: u32 = u32::MAX;
+    let mut triangles_under = vec![0u32; n];
     // Parents come before children in preorder, so its reverse is a postorder.
-    let mut preorder = Vec::with_capacity(n);
-    let mut stack = vec![0usize];
+    let mut preorder: Vec<u32> = Vec::with_capacity(n);
+    let mut stack = vec![0u32];
     while let Some(i) = stack.pop() {
         preorder.push(i);
-        if !nodes[i].is_leaf() {
-            let f = nodes[i].first_index as usize;
-            stack.extend([f, f + 1]);
+        let node = &nodes[i as usize];
+        if !node.is_leaf() {
+            stack.extend([node.first_index, node.first_index + 1]);
         }
     }
-    for &i in preorder.iter().rev() {
+    for i in preorder.into_iter().rev().map(|i| i as usize) {
         let node = &nodes[i];
         let area = node.aabb().half_area();
         if node.is_leaf() {
             let range = node.first_index as usize..(node.first_index + node.prim_count) as usize;
             let triangles = bvh2.primitive_indices[range].iter().filter(|&&p| is_triangle(p)).count() as u32;
-            counts[i] = (triangles, node.prim_count - triangles);
-            choices.cost[i] = [area * costs.leaf_cost(counts[i].0, counts[i].1); W];
+            let others = node.prim_count - triangles;
+            triangles_under[i] = if others == 0 { triangles } else { HAS_OTHERS };
+            choices.cost[i] = [area * costs.leaf_cost(triangles, others); W];
             choices.how[i] = [LEAF; W];
             continue;
         }
         let (l, r) = (node.first_index as usize, node.first_index as usize + 1);
-        counts[i] = (counts[l].0 + counts[r].0, counts[l].1 + counts[r].1);
+        triangles_under[i] = match (triangles_under[l], triangles_under[r]) {
+            (HAS_OTHERS, _) | (_, HAS_OTHERS) => HAS_OTHERS,
+            // Saturating: a sum near u32::MAX is far past any leaf's size.
+            (a, b) => a.saturating_add(b).min(HAS_OTHERS - 1),
+        };
         // distribute[j]: the cheapest j + 1 roots shared between the
         // children, at least one each (so distribute[0] is none).
         let mut distribute = [(f32::INFINITY, 0u8); W];
@@ -180,12 +190,8 @@ fn choose<const W: usize>(bvh2: &Bvh2, is_triangle: &impl Fn(u32) -> bool, costs
         choices.split[i] = split;
         // An inner node's box tests are the unit of cost.
         let inner = area + children;
-        let (triangles, others) = counts[i];
-        let as_leaf = if others == 0 && triangles <= costs.max_leaf {
-            area * costs.leaf_cost(triangles, 0)
-        } else {
-            f32::INFINITY
-        };
+        let triangles = triangles_under[i];
+        let as_leaf = if triangles <= costs.max_leaf { area * costs.leaf_cost(triangles, 0) } else { f32::INFINITY };
         let mut cost = [0.0; W];
         let mut how = [0u8; W];
         (cost[0], how[0]) = if as_leaf <= inner { (as_leaf, LEAF) } else { (inner, INNER) };
