@@ -3,7 +3,8 @@
 //! `cargo run --release --example bench_bvh [-- SUBDIVISIONS] [--no-reference] [--dump-rays DIR]`
 //!
 //! Builds a displaced sphere (a UV sphere with SUBDIVISIONS² quads, default
-//! 750² → 1.12 M triangles, radius modulated by a sum of sines), frames it
+//! 750² → 1.12 M triangles, radius modulated by a sum of sines), prints
+//! the tree's shape and its expected visits per ray, frames it
 //! with a camera and traces one coherent primary ray per pixel of a
 //! 1024×1024 image, in 8×8 blocks, then one shadow ray from each hit toward
 //! a point light, each on one thread and then on all threads: in packets
