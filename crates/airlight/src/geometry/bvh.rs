@@ -1,9 +1,9 @@
 //! A wide BVH traversed with SIMD box tests: nodes of eight children (made
 //! from obvhs's binary tree in `collapse.rs`) whose boxes are stored as
 //! structure of arrays, so that one node is four cache lines and its eight
-//! slab tests are a handful of AVX instructions (or twice as many SSE ones where the processor has no
-//! AVX; every lane type does the same IEEE operations, so the hits do not
-//! depend on the processor).
+//! slab tests are a handful of AVX instructions (or twice as many SSE ones
+//! where the processor has no AVX; every lane type does the same IEEE
+//! operations, so the hits do not depend on the processor).
 //!
 //! Why eight children rather than four: a ray descends half as many levels,
 //! and each level is a wait on memory when the tree and triangles exceed
