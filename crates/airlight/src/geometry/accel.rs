@@ -190,8 +190,8 @@ impl GeometryBuilder {
         // A binary tree of one primitive a leaf, from which the collapse
         // chooses the leaves. obvhs's second reinsertion pass (run after
         // its own leaf collapse, which leaves of one skip) is skipped too:
-        // on a 1.1 M-triangle mesh it made the build take 1.6× as long for
-        // one-ray bounces a few per cent faster.
+        // on a 1.1 M-triangle mesh it made the build take 1.6× as long,
+        // for rays one at a time 1–4% faster (BENCHMARKS.md).
         let mut params = BvhBuildParams::medium_build();
         params.max_prims_per_leaf = 1;
         params.post_collapse_reinsertion_batch_ratio_multiplier = 0.0;

@@ -14,7 +14,10 @@
 //! incoherent rays one at a time 1.05–1.09× as fast (BENCHMARKS.md has the
 //! figures).
 
+use super::blocks::blocks_of;
 use super::bvh::{Bvh, COUNT_MASK, LEAF_MIXED, Node};
+use glam::Vec3A;
+use obvhs::aabb::Aabb;
 use obvhs::bvh2::Bvh2;
 
 /// What a ray's visit costs, in units of one inner node's box tests, per
@@ -44,7 +47,7 @@ impl CollapseCosts {
     /// primitives (tested one by one where there are any).
     fn leaf_cost(&self, triangles: u32, others: u32) -> f32 {
         if others == 0 {
-            self.leaf + self.block * triangles.div_ceil(4) as f32
+            self.leaf + self.block * blocks_of(triangles) as f32
         } else {
             self.leaf + self.other * (triangles + others) as f32
         }
@@ -287,12 +290,12 @@ pub struct TreeShape {
 
 impl TreeShape {
     pub(super) fn of<const W: usize>(bvh: &Bvh<W>) -> Self {
-        let area = |node: &Node<W>, c: usize| {
-            let d = [0, 1, 2].map(|a| (node.bounds[a + 3][c] - node.bounds[a][c]) as f64);
-            (d[0] + d[1]) * d[2] + d[0] * d[1]
+        let child_box = |node: &Node<W>, c: usize| {
+            let corner = |r: usize| Vec3A::new(node.bounds[r][c], node.bounds[r + 1][c], node.bounds[r + 2][c]);
+            Aabb::new(corner(0), corner(3))
         };
-        let mut root =
-            [f32::INFINITY, f32::INFINITY, f32::INFINITY, f32::NEG_INFINITY, f32::NEG_INFINITY, f32::NEG_INFINITY];
+        let area = |node: &Node<W>, c: usize| child_box(node, c).half_area() as f64;
+        let root_area = (0..W).fold(Aabb::empty(), |b, c| b.union(&child_box(&bvh.nodes[0], c))).half_area() as f64;
         let mut shape = TreeShape {
             inner_nodes: bvh.nodes.len(),
             leaves: 0,
@@ -305,33 +308,25 @@ impl TreeShape {
             other_visits: 0.0,
         };
         let mut children = 0;
-        for (i, node) in bvh.nodes.iter().enumerate() {
+        for node in &bvh.nodes {
+            // Empty slots have min > max.
             for c in (0..W).filter(|&c| node.bounds[0][c] <= node.bounds[3][c]) {
                 children += 1;
-                if i == 0 {
-                    for a in 0..3 {
-                        root[a] = root[a].min(node.bounds[a][c]);
-                        root[a + 3] = root[a + 3].max(node.bounds[a + 3][c]);
-                    }
-                }
                 let count = node.count[c] & COUNT_MASK;
                 if count == 0 {
                     shape.inner_visits += area(node, c);
                 } else {
-                    let blocks = count.div_ceil(4) as usize;
                     shape.leaves += 1;
                     shape.leaf_visits += area(node, c);
                     if node.count[c] & LEAF_MIXED == 0 {
-                        shape.blocks += blocks;
-                        shape.block_visits += area(node, c) * blocks as f64;
+                        shape.blocks += blocks_of(count);
+                        shape.block_visits += area(node, c) * blocks_of(count) as f64;
                     } else {
                         shape.other_visits += area(node, c) * count as f64;
                     }
                 }
             }
         }
-        let d = [0, 1, 2].map(|a| (root[a + 3] - root[a]) as f64);
-        let root_area = (d[0] + d[1]) * d[2] + d[0] * d[1];
         shape.children_per_node = children as f64 / shape.inner_nodes as f64;
         shape.inner_visits = 1.0 + shape.inner_visits / root_area;
         shape.leaf_visits /= root_area;
