@@ -146,6 +146,55 @@ fn packets_agree_with_single_rays_on_a_mesh() {
 }
 
 #[test]
+fn packets_agree_whether_leaves_meet_few_rays_or_many() {
+    // A leaf that few of a packet's rays enter is tested ray by ray, one
+    // that many enter triangle by triangle across the rays: the fine mesh
+    // (two triangles a pixel) takes mostly the first, a coarse one (a
+    // hundred pixels a triangle) the second. Both give the one-ray hits.
+    for n in [240, 12] {
+        let mut b = GeometryBuilder::default();
+        b.add(&bumpy_sphere(n), 0, None);
+        let geometry = b.build();
+        let rays = camera_rays(Vec3::new(0.3, 0.8, -4.0), 160, 120, 40.0);
+        let shadow = shadow_segments(&geometry, &rays, Vec3::new(2.5, 3.0, -2.0));
+        let (hits, blocked) = agree(&geometry, &rays, f32::INFINITY, &shadow, 300);
+        assert!(hits > rays.len() / 4 && blocked > shadow.len() / 20, "{n}: {hits} hits, {blocked} blocked");
+    }
+}
+
+#[test]
+fn a_hit_exactly_at_tmax_is_past_the_open_segment_in_packets_too() {
+    // A wall of triangles at z = 1 and rays along +z from z = 0 that end
+    // at t = 1 exactly: no ray hits it, whichever way it is traced (each
+    // ray alone or a packet), and with a longer segment every ray does.
+    let mut positions = Vec::new();
+    let mut triangles = Vec::new();
+    for i in 0..=20u32 {
+        for j in 0..=20u32 {
+            positions.push(Vec3::new(i as f32 * 0.25 - 2.5, j as f32 * 0.25 - 2.5, 1.0));
+        }
+    }
+    for i in 0..20u32 {
+        for j in 0..20u32 {
+            let a = i * 21 + j;
+            triangles.push([a, a + 21, a + 1]);
+            triangles.push([a + 1, a + 21, a + 22]);
+        }
+    }
+    let mut b = GeometryBuilder::default();
+    b.add(&Shape::Mesh { positions, triangles, uvs: Vec::new() }, 0, None);
+    let geometry = b.build();
+    let rays: Vec<Ray> =
+        (0..64).map(|i| Ray::new(Vec3::new(0.0625 * (i % 8) as f32, 0.0625 * (i / 8) as f32, 0.0), Vec3::Z)).collect();
+    for (tmax, expected) in [(1.0, 0), (1.5, rays.len())] {
+        let single = rays.iter().filter(|r| geometry.intersect(r, tmax).is_some()).count();
+        assert_eq!(single, expected, "one at a time, tmax {tmax}");
+        let (hits, _) = agree(&geometry, &rays, tmax, &[], 64);
+        assert_eq!(hits, expected, "tmax {tmax}");
+    }
+}
+
+#[test]
 fn packets_of_mixed_octants_and_odd_sizes_agree() {
     let geometry = mesh_scene();
     // From inside the mesh's bounds, a camera whose view spans all eight

@@ -150,7 +150,7 @@ impl Geometry {
     /// the segment, `L::WIDTH` at a time, each lane operation for
     /// operation as [`triangle_blocks`].
     #[inline(always)]
-    fn leaf_blocks<L: Lanes>(&self, first: u32, count: u32, o: Vec3, d: Vec3, tmax: f32) -> bool {
+    pub(super) fn leaf_blocks<L: Lanes>(&self, first: u32, count: u32, o: Vec3, d: Vec3, tmax: f32) -> bool {
         let (d4, o4) = (splat::<L>(d), splat::<L>(o));
         let mut left = count as usize;
         for group in self.blocks_of_leaf(first, count).chunks(L::WIDTH.div_ceil(4)) {
@@ -202,7 +202,14 @@ impl Geometry {
     /// ray across the inside of a 1.1 M-triangle mesh tests about 19
     /// triangles in 4 leaves.
     #[inline(always)]
-    fn leaf_nearest<L: Lanes>(&self, first: u32, count: u32, o: Vec3, d: Vec3, best: (f32, u32)) -> Option<(f32, u32)> {
+    pub(super) fn leaf_nearest<L: Lanes>(
+        &self,
+        first: u32,
+        count: u32,
+        o: Vec3,
+        d: Vec3,
+        best: (f32, u32),
+    ) -> Option<(f32, u32)> {
         let (mut best_t, mut best_id) = best;
         let mut found = None;
         let (d4, o4) = (splat::<L>(d), splat::<L>(o));
