@@ -22,7 +22,10 @@ call that compiles its kernel, waiting for the result (`dr.eval`,
 `dr.sync_thread`), as the median of --passes passes. Airlight's figures are
 bench_bvh's medians on all threads (packets on the widest lanes the
 processor has: sixteen with AVX-512, eight with AVX), run from --bench
-unless --no-airlight is given.
+unless --no-airlight is given. With --one-thread both run on one thread
+(Mitsuba's pool set to one, bench_bvh's one-thread figures): rays per
+second per core, which the other core's neighbours on a shared machine
+disturb less than the two-thread figures.
 """
 
 import argparse
@@ -84,11 +87,11 @@ def timed(passes, run):
     return statistics.median(seconds), min(seconds), max(seconds), result
 
 
-def airlight_figures(bench):
-    """bench_bvh's all-thread rays per second (M): {'primary': x, 'shadow':
-    y} for its packets, from its first report (the widest lanes), and
-    'into', 'out of' for its bounces one ray at a time and in packets
-    ('into packets', 'out of packets')."""
+def airlight_figures(bench, one_thread):
+    """bench_bvh's all-thread (or one-thread) rays per second (M):
+    {'primary': x, 'shadow': y} for its packets, from its first report (the
+    widest lanes), and 'into', 'out of' for its bounces one ray at a time
+    and in packets ('into packets', 'out of packets')."""
     out = subprocess.run([bench, "--no-reference"], capture_output=True, text=True, check=True).stdout
     figures = {}
     bounce = None
@@ -100,7 +103,7 @@ def airlight_figures(bench):
             bounce = "out of"
         elif not line.startswith(" "):
             bounce = None
-        rate = lambda: float(line.split("threads:")[1].split()[0])
+        rate = lambda: float(line.split("1 thread:" if one_thread else "threads:")[1].split()[0])
         if words and words[0] in ("primary", "shadow") and words[0] not in figures:
             # "primary 1 thread: A M rays/s (B per CPU s, passes C-D)   T threads: E M rays/s (F per CPU s)"
             figures[words[0]] = rate()
@@ -118,6 +121,7 @@ def main():
     p.add_argument("--passes", type=int, default=7)
     p.add_argument("--bench", default=os.path.join(ROOT, "target", "release", "examples", "bench_bvh"))
     p.add_argument("--no-airlight", action="store_true", help="Mitsuba's figures only")
+    p.add_argument("--one-thread", action="store_true", help="both renderers on one thread (rays per second per core)")
     args = p.parse_args()
     if not os.path.exists(args.mesh):
         raise SystemExit(f"no mesh at {args.mesh}: run tools/mesh_scene.py first")
@@ -125,6 +129,8 @@ def main():
     import mitsuba as mi
 
     mi.set_variant(args.variant)
+    if args.one_thread:
+        dr.set_thread_count(1)
     scene = mi.load_dict({"type": "scene", "mesh": {"type": "obj", "filename": args.mesh}})
     origin, dirs = primary_rays()
     n = len(dirs)
@@ -212,11 +218,12 @@ def main():
         return
     if not os.path.exists(args.bench):
         raise SystemExit(f"no bench_bvh at {args.bench}: cargo build --release -p airlight --example bench_bvh")
-    figures = airlight_figures(args.bench)
-    print("Airlight packets (bench_bvh, all threads, medians of its passes):")
+    figures = airlight_figures(args.bench, args.one_thread)
+    threads = "one thread" if args.one_thread else "all threads"
+    print(f"Airlight packets (bench_bvh, {threads}, medians of its passes):")
     for kind, mitsuba in (("primary", n / t_primary / 1e6), ("shadow", m / t_shadow / 1e6)):
         print(f"  {kind:7} {figures[kind]:6.2f} M rays/s: {figures[kind] / mitsuba:.2f}x Mitsuba's")
-    print("Airlight bounces (bench_bvh, all threads, one ray at a time and in packets):")
+    print(f"Airlight bounces (bench_bvh, {threads}, one ray at a time and in packets):")
     for kind, (rate, _, _, _) in bounces.items():
         one, packets = figures[kind], figures[kind + " packets"]
         print(f"  {kind:6} the mesh {one:6.2f} and {packets:6.2f} M rays/s: {one / rate:.2f}x and {packets / rate:.2f}x Mitsuba's")
