@@ -125,6 +125,15 @@ def main():
     args = p.parse_args()
     if not os.path.exists(args.mesh):
         raise SystemExit(f"no mesh at {args.mesh}: run tools/mesh_scene.py first")
+    # Airlight's figures first, before Mitsuba's thread pool exists: its
+    # workers, left waiting after a call, took time from bench_bvh's
+    # threads when it ran after them (one-thread primary rays 15.8 M/s
+    # so, against 21.3-21.5 in runs of bench_bvh alone).
+    figures = None
+    if not args.no_airlight:
+        if not os.path.exists(args.bench):
+            raise SystemExit(f"no bench_bvh at {args.bench}: cargo build --release -p airlight --example bench_bvh")
+        figures = airlight_figures(args.bench, args.one_thread)
     import drjit as dr
     import mitsuba as mi
 
@@ -214,11 +223,8 @@ def main():
     print(f"  shadow  {m / t_shadow / 1e6:6.2f} M rays/s (passes {m / slowest_s / 1e6:.2f}-{m / fastest_s / 1e6:.2f})")
     for kind, (rate, slowest, fastest, hit) in bounces.items():
         print(f"  bounces {kind} the mesh ({100 * hit:.1f}% hit) {rate:6.2f} M rays/s (passes {slowest:.2f}-{fastest:.2f})")
-    if args.no_airlight:
+    if figures is None:
         return
-    if not os.path.exists(args.bench):
-        raise SystemExit(f"no bench_bvh at {args.bench}: cargo build --release -p airlight --example bench_bvh")
-    figures = airlight_figures(args.bench, args.one_thread)
     threads = "one thread" if args.one_thread else "all threads"
     print(f"Airlight packets (bench_bvh, {threads}, medians of its passes):")
     for kind, mitsuba in (("primary", n / t_primary / 1e6), ("shadow", m / t_shadow / 1e6)):
