@@ -125,10 +125,10 @@ def main():
     args = p.parse_args()
     if not os.path.exists(args.mesh):
         raise SystemExit(f"no mesh at {args.mesh}: run tools/mesh_scene.py first")
-    # Airlight's figures first, before Mitsuba's thread pool exists: its
-    # workers, left waiting after a call, took time from bench_bvh's
-    # threads when it ran after them (one-thread primary rays 15.8 M/s
-    # so, against 21.3-21.5 in runs of bench_bvh alone).
+    # Airlight's figures first, before Mitsuba's thread pool exists: run
+    # after Mitsuba's rays, beside its idle pool, bench_bvh gave one-thread
+    # camera packets 15.8 and 18.5 M rays/s, against 21.3-21.5 in runs of
+    # its own.
     figures = None
     if not args.no_airlight:
         if not os.path.exists(args.bench):

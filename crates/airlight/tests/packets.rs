@@ -149,8 +149,9 @@ fn packets_agree_with_single_rays_on_a_mesh() {
 fn packets_agree_whether_leaves_meet_few_rays_or_many() {
     // A leaf that few of a packet's rays enter is tested ray by ray, one
     // that many enter triangle by triangle across the rays: the fine mesh
-    // (two triangles a pixel) takes mostly the first, a coarse one (a
-    // hundred pixels a triangle) the second. Both give the one-ray hits.
+    // (about eight triangles a pixel) takes mostly the first, a coarse one
+    // (about fifty pixels a triangle) the second. Both give the one-ray
+    // hits.
     for n in [240, 12] {
         let mut b = GeometryBuilder::default();
         b.add(&bumpy_sphere(n), 0, None);

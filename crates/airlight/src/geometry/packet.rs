@@ -16,7 +16,10 @@
 //! same arithmetic, operation for operation, as the one-ray
 //! [`intersect_triangle`](super::intersect_triangle) (shadow rays: as
 //! [`triangle_blocks`](super::triangle_blocks)), so a ray's hit distance,
-//! or blocked-or-not, is the same bits whichever way it is traced.
+//! or blocked-or-not, is the same bits whichever way it is traced. A leaf
+//! that only a few of the packet's rays enter is tested ray by ray instead,
+//! as one ray alone tests it (`batch.rs`): on a mesh whose triangles are
+//! about a pixel in size, many leaves are.
 //!
 //! All rays of a packet share their direction's sign on each axis (the
 //! caller groups rays so), which makes the near plane of every box the same
