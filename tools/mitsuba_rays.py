@@ -125,10 +125,12 @@ def main():
     args = p.parse_args()
     if not os.path.exists(args.mesh):
         raise SystemExit(f"no mesh at {args.mesh}: run tools/mesh_scene.py first")
-    # Airlight's figures first, before Mitsuba's thread pool exists: run
-    # after Mitsuba's rays, beside its idle pool, bench_bvh gave one-thread
-    # camera packets 15.8 and 18.5 M rays/s, against 21.3-21.5 in runs of
-    # its own.
+    # Airlight's figures first, before Mitsuba is loaded: run after
+    # Mitsuba's rays, bench_bvh twice gave one-thread camera packets of
+    # 15.8 and 18.5 M rays/s, against 21.3-21.5 in runs of its own. (Not
+    # from Mitsuba's idle threads: the Python process used 0.02 s of CPU
+    # while a 3 s child ran. The cause is not known; the order rules the
+    # interplay out.)
     figures = None
     if not args.no_airlight:
         if not os.path.exists(args.bench):
