@@ -15,4 +15,13 @@ impl Integrator for Direct {
     fn radiance_batch(&self, scene: &Scene, rays: &[Ray], samplers: &mut [Sampler], out: &mut [Rgb]) {
         first_surface_batch(scene, rays, samplers, out)
     }
+
+    /// Four blocks: only the lit hits trace a shadow ray (about 42 of a
+    /// block's 64 camera rays on the 1.1 M-triangle mesh), so a batch of
+    /// one block filled two thirds of a packet, and four fill them. The
+    /// batch's work took 4.2% fewer instructions so (callgrind, the mesh
+    /// at 1 spp); more blocks gained nothing more in time.
+    fn batch_blocks(&self) -> usize {
+        4
+    }
 }

@@ -77,6 +77,15 @@ pub trait Integrator: Send + Sync {
         false
     }
 
+    /// How many blocks of neighbouring pixels' samples one call of
+    /// [`Integrator::radiance_batch`] may take (each block's samples
+    /// still in order). One by default; more lets rays traced later in a
+    /// batch, such as shadow rays from only the lit hits, fill whole
+    /// packets.
+    fn batch_blocks(&self) -> usize {
+        1
+    }
+
     /// The scene's lights changed ([`Scene::set_lights`], [`Scene::at_time`]):
     /// update what was derived from them (radiosity relights its patches
     /// without recompiling; the analytic integrator re-places its emitters).

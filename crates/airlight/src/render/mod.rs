@@ -233,11 +233,14 @@ type TileRows<'a, T = PixelSum> = Vec<&'a mut [T]>;
 /// whose top-left pixel is (x0, y0), drawn with `seed`, into `tile`, its
 /// rows of pixel sums; returns how many samples that was. The samples of
 /// each [`BLOCK`]×[`BLOCK`] block of pixels go to the integrator together,
-/// [`BLOCK_ORDER`]'s count at a time: sample number by sample number, each
-/// number with the pixels in [`BLOCK_ORDER`] whose range holds it. (Where
-/// the pixels' counts differ, as under adaptive sampling, a batch so
-/// takes the next numbers of the pixels that still have samples, rather
-/// than shrinking to them: a pixel's own rays are the most alike.) Each
+/// [`BLOCK_ORDER`]'s count times [`Integrator::batch_blocks`] at a time:
+/// sample number by sample number, each number with the pixels in
+/// [`BLOCK_ORDER`] whose range holds it. (Where the pixels' counts differ,
+/// as under adaptive sampling, a batch so takes the next numbers of the
+/// pixels that still have samples, rather than shrinking to them: a
+/// pixel's own rays are the most alike.) A batch holds whole blocks' worth
+/// of samples, and the next block's start a new one where it might not
+/// fit, so that a packet's rays stay within a block. Each
 /// pixel's sum is [`pixel_sum`]'s, bit for bit: the same samples, and the
 /// sums are exact, so the order they are added in does not matter.
 fn tile_sums(
@@ -251,7 +254,7 @@ fn tile_sums(
     let s = scene.settings();
     let (x1, y1) = (x0 + tile.first().map_or(0, |row| row.len() as u32), y0 + tile.len() as u32);
     let film = scene.camera().rays(s.width, s.height);
-    let n = BLOCK_ORDER.len();
+    let n = BLOCK_ORDER.len() * integrator.batch_blocks().max(1);
     let mut block = Vec::with_capacity(n);
     let (mut pixels, mut rays, mut samplers) = (Vec::with_capacity(n), Vec::with_capacity(n), Vec::with_capacity(n));
     let mut radiance = vec![Rgb::ZERO; n];
@@ -290,10 +293,14 @@ fn tile_sums(
                     }
                 }
             }
-            if !pixels.is_empty() {
+            // A batch ends with a block: the next one might not fit.
+            if pixels.len() + BLOCK_ORDER.len() > n {
                 trace(&mut pixels, &mut rays, &mut samplers);
             }
         }
+    }
+    if !pixels.is_empty() {
+        trace(&mut pixels, &mut rays, &mut samplers);
     }
     done
 }
