@@ -62,7 +62,7 @@ impl Scene {
     /// The shadow ray that [`Scene::light_visible`] traces, or None where
     /// it traces none and answers "not visible" (the sample point is the
     /// origin itself): for callers that trace many at once
-    /// ([`Geometry::occluded_packet`]).
+    /// ([`Geometry::occluded_packet`](crate::geometry::Geometry::occluded_packet)).
     #[inline]
     pub fn light_segment(&self, p: Vec3, origin: Vec3, wi: Vec3, distance: f32) -> Option<Segment> {
         const SHORT: f32 = 1.0 - 1e-4;

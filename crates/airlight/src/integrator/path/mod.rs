@@ -8,7 +8,7 @@
 //! path weighted over the three channels (r_u and r_l hold each channel's
 //! unidirectional and light-sampling path pdfs relative to the hero's):
 //! by the power heuristic where light sampling and BRDF or phase sampling
-//! both find an area light ([`power_heuristic`]), by the balance heuristic
+//! both find an area light (`mis::power_heuristic`), by the balance heuristic
 //! elsewhere. In fog around point lights, new directions are also drawn
 //! toward the brightest lights (guide.rs).
 
