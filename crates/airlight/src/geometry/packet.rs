@@ -26,7 +26,7 @@
 //! for all of them. The arithmetic is written once over [`Lanes`]
 //! (`lanes.rs`).
 
-use super::bvh::{Bvh, COUNT_MASK, FAR_SCALE, LEAF_MIXED, Node, STACK_SIZE, far_row, is_triangle_leaf};
+use super::bvh::{Bvh, COUNT_MASK, FAR_SCALE, LEAF_MIXED, Node, Stack, far_row, is_triangle_leaf};
 use super::lanes::Lanes;
 use glam::Vec3;
 
@@ -319,7 +319,7 @@ pub fn prefetch<T>(value: &T) {
 }
 
 /// A deferred visit: child `slot` of node `node`, for the rays in `mask`.
-#[derive(Clone, Copy, Default)]
+#[derive(Clone, Copy)]
 struct Entry {
     node: u32,
     slot: u32,
@@ -348,8 +348,7 @@ impl<const W: usize> Bvh<W> {
         prefetch_leaf: impl Fn(u32, u32),
     ) {
         let mut alive = mask & packet.all();
-        let mut stack = [Entry::default(); STACK_SIZE];
-        let mut top = 0;
+        let mut stack = Stack::new();
         // The root is an inner node whose children all rays may enter.
         let mut expand = Some((0usize, alive));
         loop {
@@ -378,8 +377,7 @@ impl<const W: usize> Bvh<W> {
                     n += 1;
                 }
                 for &(c, _) in &order[..n] {
-                    stack[top] = Entry { node: index as u32, slot: c as u32, mask: rays };
-                    top += 1;
+                    stack.push(Entry { node: index as u32, slot: c as u32, mask: rays });
                     // Start fetching what the child holds, which is most
                     // often not in cache yet, while the nearer ones run.
                     if node.count[c] == 0 {
@@ -389,11 +387,10 @@ impl<const W: usize> Bvh<W> {
                     }
                 }
             }
-            if top == 0 || alive == 0 {
+            if alive == 0 {
                 return;
             }
-            top -= 1;
-            let e = stack[top];
+            let Some(e) = stack.pop() else { return };
             let parent = &self.nodes[e.node as usize];
             let slot = e.slot as usize;
             let rays = packet.enter::<L, W>(parent, slot, e.mask & alive);

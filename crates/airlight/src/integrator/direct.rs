@@ -20,7 +20,8 @@ impl Integrator for Direct {
     /// block's 64 camera rays on the 1.1 M-triangle mesh), so a batch of
     /// one block filled two thirds of a packet, and four fill them. The
     /// batch's work took 4.2% fewer instructions so (callgrind, the mesh
-    /// at 1 spp); more blocks gained nothing more in time.
+    /// at 1 spp, part of it the packets' stack zeroing since removed); in
+    /// time the gain was within the machine's noise.
     fn batch_blocks(&self) -> usize {
         4
     }
