@@ -405,8 +405,9 @@ fn next_up(x: f32) -> f32 {
 /// ray against the leaf's triangles four at a time, as one ray alone is
 /// tested) than triangle by triangle against the groups of `L::WIDTH`
 /// rays that hold `rays`. Camera rays meet leaves of a fine mesh a few at
-/// a time (six of a 64-ray packet on average on the 1.1 M-triangle mesh
-/// of bench_bvh), which leaves most lanes of a group idle. A ray's test is
+/// a time (on the 1.1 M-triangle mesh of bench_bvh, half the leaves a
+/// 64-ray packet visits are entered by six of its rays or fewer), which
+/// leaves most lanes of a group idle. A ray's test is
 /// weighed as four times a four-lane test: what it costs besides (the ray
 /// splat into lanes, its hits read lane by lane) made a weight of 4 the
 /// fastest of 1, 2, 4, 8 and never per ray. Both ways give each ray the

@@ -156,7 +156,8 @@ struct Entry {
 /// A traversal stack, left uninitialised: zeroing it per ray (2 KB then,
 /// with four children a node; 3 KB now) cost more than the traversal of a
 /// coherent ray. (Per packet it was 4 KB, which callgrind counted as 7.6%
-/// of a direct render's instructions but which took no measurable time.)
+/// of the instructions of a direct render's batches but which took no
+/// measurable time.)
 pub(super) struct Stack<T: Copy> {
     entries: [std::mem::MaybeUninit<T>; STACK_SIZE],
     top: usize,

@@ -18,7 +18,7 @@ impl Integrator for Direct {
 
     /// Four blocks: only the lit hits trace a shadow ray (about 42 of a
     /// block's 64 camera rays on the 1.1 M-triangle mesh), so a batch of
-    /// one block filled two thirds of a packet, and four fill them. The
+    /// one block filled two thirds of a packet, and four fill most. The
     /// batch's work took 4.2% fewer instructions so (callgrind, the mesh
     /// at 1 spp, part of it the packets' stack zeroing since removed); in
     /// time the gain was within the machine's noise.

@@ -238,9 +238,8 @@ type TileRows<'a, T = PixelSum> = Vec<&'a mut [T]>;
 /// [`BLOCK_ORDER`] whose range holds it. (Where the pixels' counts differ,
 /// as under adaptive sampling, a batch so takes the next numbers of the
 /// pixels that still have samples, rather than shrinking to them: a
-/// pixel's own rays are the most alike.) A batch holds whole blocks' worth
-/// of samples, and the next block's start a new one where it might not
-/// fit, so that a packet's rays stay within a block. Each
+/// pixel's own rays are the most alike.) After each block, the batch is
+/// traced if one more sample of a whole block would not fit in it. Each
 /// pixel's sum is [`pixel_sum`]'s, bit for bit: the same samples, and the
 /// sums are exact, so the order they are added in does not matter.
 fn tile_sums(
@@ -293,7 +292,7 @@ fn tile_sums(
                     }
                 }
             }
-            // A batch ends with a block: the next one might not fit.
+            // Traced now if one more block's sample would not fit.
             if pixels.len() + BLOCK_ORDER.len() > n {
                 trace(&mut pixels, &mut rays, &mut samplers);
             }
