@@ -127,7 +127,64 @@ impl CameraRays {
         let lens_point = origin + c.right * disk.x + c.up * disk.y;
         Ray::new(lens_point, (focus - lens_point).normalize())
     }
+
+    /// The rays through film points `films` and lens points `lenses`, as
+    /// [`CameraRays::ray`] gives them one by one, bit for bit, appended to
+    /// `out`. A pinhole's directions are worked out [`RAY_LANES`] at a time
+    /// in arrays, a loop that the compiler turns into SIMD lanes with the
+    /// same IEEE operations. One by one, each ray's two divisions, square
+    /// root and reciprocal waited on each other: a direct render of a 1.1
+    /// M-triangle mesh at one thread spent 18% of its sampling time on
+    /// camera rays and their samplers, and 12% with the lanes (perf).
+    pub fn rays_into(&self, films: &[Vec2], lenses: &[Vec2], out: &mut Vec<Ray>) {
+        assert_eq!(films.len(), lenses.len(), "one lens point per film point");
+        let c = &self.camera;
+        if !matches!(c.projection, Projection::Perspective { .. }) || c.aperture > 0.0 {
+            out.extend(films.iter().zip(lenses).map(|(&film, &lens)| self.ray(film, lens)));
+            return;
+        }
+        for chunk in films.chunks(RAY_LANES) {
+            // Past the chunk's end, film point (0, 0): a finite direction,
+            // computed and dropped.
+            let (mut film_x, mut film_y) = ([0.0f32; RAY_LANES], [0.0f32; RAY_LANES]);
+            for (k, film) in chunk.iter().enumerate() {
+                (film_x[k], film_y[k]) = (film.x, film.y);
+            }
+            let dir = self.pinhole_directions(&film_x, &film_y);
+            out.extend((0..chunk.len()).map(|k| Ray::new(c.position, Vec3::new(dir[0][k], dir[1][k], dir[2][k]))));
+        }
+    }
+
+    /// A pinhole's unit directions through film points (x, y), lane by
+    /// lane what [`CameraRays::ray`] computes. Not inlined: inlined into
+    /// its caller's loop, the compiler left it one lane at a time.
+    #[inline(never)]
+    fn pinhole_directions(&self, film_x: &[f32; RAY_LANES], film_y: &[f32; RAY_LANES]) -> [[f32; RAY_LANES]; 3] {
+        let c = &self.camera;
+        let (half, aspect) = (self.half, self.width / self.height);
+        let mut dir = [[0.0f32; RAY_LANES]; 3];
+        for k in 0..RAY_LANES {
+            let ndc_x = 2.0 * film_x[k] / self.width - 1.0;
+            let ndc_y = 1.0 - 2.0 * film_y[k] / self.height;
+            let (sx, sy) = (ndc_x * half * aspect, ndc_y * half);
+            // `forward + right·sx + up·sy`, then glam's `normalize`: each
+            // component times 1 / sqrt((x·x + y·y) + z·z).
+            let x = c.forward.x + c.right.x * sx + c.up.x * sy;
+            let y = c.forward.y + c.right.y * sx + c.up.y * sy;
+            let z = c.forward.z + c.right.z * sx + c.up.z * sy;
+            let recip = 1.0 / (x * x + y * y + z * z).sqrt();
+            dir[0][k] = x * recip;
+            dir[1][k] = y * recip;
+            dir[2][k] = z * recip;
+        }
+        dir
+    }
 }
+
+/// Camera rays worked out together in [`CameraRays::rays_into`]: two SSE
+/// registers' worth (the instructions every x86-64 processor has, which
+/// the crate is compiled for).
+const RAY_LANES: usize = 8;
 
 #[cfg(test)]
 mod tests {
@@ -168,5 +225,37 @@ mod tests {
         // The image height spans view_height world units.
         let spread = (a.origin - b.origin).dot(cam.up);
         assert!((spread - 10.0).abs() < 1e-4);
+    }
+
+    #[test]
+    fn rays_made_together_are_the_rays_made_one_by_one_bit_for_bit() {
+        let pinhole = Camera::look_at(Vec3::new(0.3, 2.0, -6.0), Vec3::new(-0.2, 1.0, 0.5), Vec3::Y, 47.0);
+        let cameras = [pinhole, pinhole.with_lens(0.2, 5.0), Camera::isometric(Vec3::new(1.0, 0.0, 2.0), 10.0, 50.0)];
+        // Every length up to two chunks and a bit, so that partial chunks
+        // (and their dropped lanes) are covered; points across the film and
+        // beyond its edges.
+        let mut rng = crate::sampling::Sampler::for_pixel(7, 0, 0);
+        let points: Vec<(Vec2, Vec2)> = (0..2 * RAY_LANES + 3)
+            .map(|_| (rng.next2() * Vec2::new(130.0, 90.0) - Vec2::splat(3.0), rng.next2()))
+            .collect();
+        for camera in cameras {
+            let rays = camera.rays(123, 77);
+            for n in 0..=points.len() {
+                let (films, lenses): (Vec<Vec2>, Vec<Vec2>) = points[..n].iter().copied().unzip();
+                let mut together = vec![];
+                rays.rays_into(&films, &lenses, &mut together);
+                let one_by_one: Vec<Ray> = points[..n].iter().map(|&(film, lens)| rays.ray(film, lens)).collect();
+                let bits = |rays: &[Ray]| -> Vec<[u32; 6]> {
+                    rays.iter()
+                        .map(|r| {
+                            let [a, b, c] = r.origin.to_array().map(f32::to_bits);
+                            let [d, e, f] = r.dir.to_array().map(f32::to_bits);
+                            [a, b, c, d, e, f]
+                        })
+                        .collect()
+                };
+                assert_eq!(bits(&together), bits(&one_by_one), "{camera:?}, {n} rays");
+            }
+        }
     }
 }

@@ -255,19 +255,21 @@ fn tile_sums(
     let film = scene.camera().rays(s.width, s.height);
     let n = BLOCK_ORDER.len() * integrator.batch_blocks().max(1);
     let mut block = Vec::with_capacity(n);
-    let (mut pixels, mut rays, mut samplers) = (Vec::with_capacity(n), Vec::with_capacity(n), Vec::with_capacity(n));
+    let mut batch = Batch::with_capacity(n);
+    let mut rays = Vec::with_capacity(n);
     let mut radiance = vec![Rgb::ZERO; n];
     let mut done = 0;
-    let mut trace = |pixels: &mut Vec<(u32, u32)>, rays: &mut Vec<_>, samplers: &mut Vec<Sampler>| {
-        let radiance = &mut radiance[..pixels.len()];
-        integrator.radiance_batch(scene, rays, samplers, radiance);
-        for (&(x, y), r) in pixels.iter().zip(radiance.iter()) {
+    // The batch's camera rays made together (`CameraRays::rays_into`), traced, added to the tile.
+    let mut trace = |batch: &mut Batch| {
+        rays.clear();
+        film.rays_into(&batch.films, &batch.lenses, &mut rays);
+        let radiance = &mut radiance[..batch.pixels.len()];
+        integrator.radiance_batch(scene, &rays, &mut batch.samplers, radiance);
+        for (&(x, y), r) in batch.pixels.iter().zip(radiance.iter()) {
             tile[(y - y0) as usize][(x - x0) as usize].add(*r);
         }
-        done += pixels.len() as u64;
-        pixels.clear();
-        rays.clear();
-        samplers.clear();
+        done += batch.pixels.len() as u64;
+        batch.clear();
     };
     for by in (y0..y1).step_by(BLOCK as usize) {
         for bx in (x0..x1).step_by(BLOCK as usize) {
@@ -284,24 +286,53 @@ fn tile_sums(
             for i in first..end {
                 for (x, y, _) in block.iter().filter(|(.., r)| r.contains(&i)) {
                     let mut sampler = Sampler::for_pixel(seed, *y as u64 * s.width as u64 + *x as u64, i);
-                    rays.push(film_ray(&film, s.filter, integrator.stratified(), *x, *y, &mut sampler));
-                    samplers.push(sampler);
-                    pixels.push((*x, *y));
-                    if pixels.len() == n {
-                        trace(&mut pixels, &mut rays, &mut samplers);
+                    let (point, lens) = film_sample(s.filter, integrator.stratified(), *x, *y, &mut sampler);
+                    batch.films.push(point);
+                    batch.lenses.push(lens);
+                    batch.samplers.push(sampler);
+                    batch.pixels.push((*x, *y));
+                    if batch.pixels.len() == n {
+                        trace(&mut batch);
                     }
                 }
             }
             // Traced now if one more block's sample would not fit.
-            if pixels.len() + BLOCK_ORDER.len() > n {
-                trace(&mut pixels, &mut rays, &mut samplers);
+            if batch.pixels.len() + BLOCK_ORDER.len() > n {
+                trace(&mut batch);
             }
         }
     }
-    if !pixels.is_empty() {
-        trace(&mut pixels, &mut rays, &mut samplers);
+    if !batch.pixels.is_empty() {
+        trace(&mut batch);
     }
     done
+}
+
+/// Samples waiting to be traced together: each one's pixel, film and lens
+/// points (its camera ray, made when the batch is traced) and sampler.
+struct Batch {
+    pixels: Vec<(u32, u32)>,
+    films: Vec<Vec2>,
+    lenses: Vec<Vec2>,
+    samplers: Vec<Sampler>,
+}
+
+impl Batch {
+    fn with_capacity(n: usize) -> Self {
+        Batch {
+            pixels: Vec::with_capacity(n),
+            films: Vec::with_capacity(n),
+            lenses: Vec::with_capacity(n),
+            samplers: Vec::with_capacity(n),
+        }
+    }
+
+    fn clear(&mut self) {
+        self.pixels.clear();
+        self.films.clear();
+        self.lenses.clear();
+        self.samplers.clear();
+    }
 }
 
 /// The samples `samples` of pixel (x, y), summed.
@@ -342,6 +373,13 @@ pub(crate) fn film_ray(
     y: u32,
     sampler: &mut Sampler,
 ) -> crate::geometry::Ray {
+    let (point, lens) = film_sample(filter, stratified, x, y, sampler);
+    film.ray(point, lens)
+}
+
+/// The film point in pixel (x, y) and the lens point of a sample's camera
+/// ray, drawn from its `sampler` as [`camera_ray`] draws them.
+fn film_sample(filter: PixelFilter, stratified: bool, x: u32, y: u32, sampler: &mut Sampler) -> (Vec2, Vec2) {
     let (jitter, lens) = if stratified {
         let u = sampler.stratified4(0);
         (Vec2::new(u[0], u[1]), Vec2::new(u[2], u[3]))
@@ -353,7 +391,7 @@ pub(crate) fn film_ray(
             PixelFilter::Box => jitter,
             PixelFilter::Point => Vec2::splat(0.5),
         };
-    film.ray(point, lens)
+    (point, lens)
 }
 
 /// Moves `scene` to `time` in [0, 1] of its light animation and tells
