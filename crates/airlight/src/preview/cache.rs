@@ -25,10 +25,10 @@ use crate::film::Image;
 use crate::geometry::{Geometry, GeometryBuilder, Ray, SurfaceHit};
 use crate::integrator::{surface_radiance, through_medium};
 use crate::radiosity::Radiosity;
-use crate::render::film_ray;
+use crate::render::film_sample;
 use crate::sampling::Sampler;
 use crate::scene::{PixelFilter, Scene};
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 use std::f32::consts::FRAC_1_PI;
 
@@ -178,11 +178,17 @@ impl FirstSample {
         self.texels.par_chunks_mut(w.max(1)).zip(self.weights.par_iter_mut()).enumerate().for_each(
             |(y, (texels, weights))| {
                 weights.clear();
-                for (x, texel) in texels.iter_mut().enumerate() {
-                    let mut sampler = first_sampler(scene, (y * w + x) as u64);
-                    // The preview's camera numbers are not stratified: two
-                    // independent pairs, which `shade` skips.
-                    let ray = film_ray(&camera, s.filter, false, x as u32, y as u32, &mut sampler);
+                // The row's camera rays, made together. The preview's camera
+                // numbers are not stratified: two independent pairs, which
+                // `shade` skips.
+                let (films, lenses): (Vec<Vec2>, Vec<Vec2>) = (0..texels.len())
+                    .map(|x| {
+                        film_sample(s.filter, false, x as u32, y as u32, &mut first_sampler(scene, (y * w + x) as u64))
+                    })
+                    .unzip();
+                let mut rays = Vec::with_capacity(texels.len());
+                camera.rays_into(&films, &lenses, &mut rays);
+                for (x, (texel, ray)) in texels.iter_mut().zip(rays).enumerate() {
                     *texel = Texel::missed(ray);
                     if let Some(hit) = objects.intersect(&ray, f32::INFINITY) {
                         let surface = objects.surface(&ray, hit);

@@ -379,7 +379,13 @@ pub(crate) fn film_ray(
 
 /// The film point in pixel (x, y) and the lens point of a sample's camera
 /// ray, drawn from its `sampler` as [`camera_ray`] draws them.
-fn film_sample(filter: PixelFilter, stratified: bool, x: u32, y: u32, sampler: &mut Sampler) -> (Vec2, Vec2) {
+pub(crate) fn film_sample(
+    filter: PixelFilter,
+    stratified: bool,
+    x: u32,
+    y: u32,
+    sampler: &mut Sampler,
+) -> (Vec2, Vec2) {
     let (jitter, lens) = if stratified {
         let u = sampler.stratified4(0);
         (Vec2::new(u[0], u[1]), Vec2::new(u[2], u[3]))
