@@ -130,7 +130,7 @@ impl CameraRays {
 
     /// The rays through film points `films` and lens points `lenses`, as
     /// [`CameraRays::ray`] gives them one by one, bit for bit, appended to
-    /// `out`. A pinhole's directions are worked out [`RAY_LANES`] at a time
+    /// `out`. A pinhole's directions are worked out eight at a time
     /// in arrays, a loop that the compiler turns into SIMD lanes with the
     /// same IEEE operations. One by one, each ray's two divisions, square
     /// root and reciprocal waited on each other: a direct render of a 1.1
