@@ -104,17 +104,11 @@ impl CameraRays {
     #[inline]
     pub fn ray(&self, film: Vec2, lens: Vec2) -> Ray {
         let c = &self.camera;
-        let (half, aspect) = (self.half, self.width / self.height);
-        let ndc_x = 2.0 * film.x / self.width - 1.0;
-        let ndc_y = 1.0 - 2.0 * film.y / self.height;
         let (origin, dir) = match c.projection {
-            Projection::Perspective { .. } => {
-                let d = c.forward + c.right * (ndc_x * half * aspect) + c.up * (ndc_y * half);
-                (c.position, d.normalize())
-            }
+            Projection::Perspective { .. } => (c.position, self.pinhole_direction(film)),
             Projection::Orthographic { .. } => {
-                let o = c.position + c.right * (ndc_x * half * aspect) + c.up * (ndc_y * half);
-                (o, c.forward)
+                let (right, up) = self.film_offsets(film);
+                (c.position + c.right * right + c.up * up, c.forward)
             }
         };
         if c.aperture <= 0.0 {
@@ -156,28 +150,35 @@ impl CameraRays {
     }
 
     /// A pinhole's unit directions through film points (x, y), lane by
-    /// lane what [`CameraRays::ray`] computes. Not inlined: inlined into
+    /// lane [`CameraRays::pinhole_direction`]. Not inlined: inlined into
     /// its caller's loop, the compiler left it one lane at a time.
     #[inline(never)]
     fn pinhole_directions(&self, film_x: &[f32; RAY_LANES], film_y: &[f32; RAY_LANES]) -> [[f32; RAY_LANES]; 3] {
-        let c = &self.camera;
-        let (half, aspect) = (self.half, self.width / self.height);
         let mut dir = [[0.0f32; RAY_LANES]; 3];
         for k in 0..RAY_LANES {
-            let ndc_x = 2.0 * film_x[k] / self.width - 1.0;
-            let ndc_y = 1.0 - 2.0 * film_y[k] / self.height;
-            let (sx, sy) = (ndc_x * half * aspect, ndc_y * half);
-            // `forward + right·sx + up·sy`, then glam's `normalize`: each
-            // component times 1 / sqrt((x·x + y·y) + z·z).
-            let x = c.forward.x + c.right.x * sx + c.up.x * sy;
-            let y = c.forward.y + c.right.y * sx + c.up.y * sy;
-            let z = c.forward.z + c.right.z * sx + c.up.z * sy;
-            let recip = 1.0 / (x * x + y * y + z * z).sqrt();
-            dir[0][k] = x * recip;
-            dir[1][k] = y * recip;
-            dir[2][k] = z * recip;
+            let d = self.pinhole_direction(Vec2::new(film_x[k], film_y[k]));
+            (dir[0][k], dir[1][k], dir[2][k]) = (d.x, d.y, d.z);
         }
         dir
+    }
+
+    /// A pinhole's unit direction through film point `film`.
+    #[inline(always)]
+    fn pinhole_direction(&self, film: Vec2) -> Vec3 {
+        let c = &self.camera;
+        let (right, up) = self.film_offsets(film);
+        (c.forward + c.right * right + c.up * up).normalize()
+    }
+
+    /// How far along the camera's right and up axes film point `film`
+    /// lies: on the image plane at distance 1 for a pinhole, in world units
+    /// for an orthographic camera.
+    #[inline(always)]
+    fn film_offsets(&self, film: Vec2) -> (f32, f32) {
+        let (half, aspect) = (self.half, self.width / self.height);
+        let ndc_x = 2.0 * film.x / self.width - 1.0;
+        let ndc_y = 1.0 - 2.0 * film.y / self.height;
+        (ndc_x * half * aspect, ndc_y * half)
     }
 }
 
