@@ -236,3 +236,45 @@ fn packets_of_random_rays_agree_in_the_lamp_room() {
     let (hits, blocked) = agree(geometry, &rays, f32::INFINITY, &shadow, 6000);
     assert!(hits > 1200 && blocked > 1000, "{hits} hits, {blocked} blocked");
 }
+
+/// A small scene (the Cornell box: five quads, two turned boxes and its
+/// light's quad) takes its packets through the quads' and boxes' lanes,
+/// eight rays against one primitive at a time, not through the tree: the
+/// one-ray answers still, for camera rays from outside the room and from
+/// inside it, for shadow rays toward the light, and, with a bound of each
+/// ray's own, for `intersect_each`, on that scene and on one of a quad alone.
+#[test]
+fn packets_agree_in_a_small_scene() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/cornell_box.toml");
+    let scene = airlight::SceneFile::load(&path).expect("scene loads").scene;
+    let geometry = scene.geometry();
+    let light = Vec3::new(2.78, 5.4, 2.8);
+    let mut total = (0, 0);
+    let centre = Vec3::new(2.78, 2.73, 2.8);
+    for (eye, fov) in [(Vec3::new(2.78, 2.73, -8.0), 40.0), (Vec3::new(2.0, 2.0, 1.0), 150.0)] {
+        // Toward the room's centre (`camera_rays` looks at the origin).
+        let rays: Vec<Ray> =
+            camera_rays(eye - centre, 45, 37, fov).into_iter().map(|r| Ray::new(r.origin + centre, r.dir)).collect();
+        let shadow = shadow_segments(geometry, &rays, light);
+        let (hits, blocked) = agree(geometry, &rays, f32::INFINITY, &shadow, 200);
+        total = (total.0 + hits, total.1 + blocked);
+    }
+    assert!(total.0 > 2500 && total.1 > 100, "{total:?}");
+    let mut quad = GeometryBuilder::default();
+    quad.add(
+        &Shape::Quad { corner: Vec3::new(-1.0, -1.0, 2.0), edge_u: Vec3::X * 2.0, edge_v: Vec3::Y * 2.0 },
+        0,
+        None,
+    );
+    let quad = quad.build();
+    for (geometry, origin) in [(geometry, Vec3::new(2.0, 2.0, 1.0)), (&quad, Vec3::new(0.2, 0.1, 1.5))] {
+        let mut s = Sampler::for_pixel(9, 9, 9);
+        let rays: Vec<Ray> = (0..301).map(|_| Ray::new(origin, uniform_sphere(s.next2()))).collect();
+        let tmax: Vec<f32> = rays.iter().map(|_| if s.next() < 0.2 { f32::INFINITY } else { 8.0 * s.next() }).collect();
+        let mut each = vec![None; rays.len()];
+        geometry.intersect_each(&rays, &tmax, &mut each);
+        let single: Vec<Option<Hit>> = rays.iter().zip(&tmax).map(|(r, &t)| geometry.intersect(r, t)).collect();
+        assert_eq!(each, single);
+        assert!(single.iter().filter(|h| h.is_some()).count() > 20);
+    }
+}

@@ -6,6 +6,7 @@
 //! `packet.rs`.
 
 use super::Ray;
+use super::batch::Segment;
 use super::blocks::{TriangleBlock, into_blocks};
 use super::bvh::Bvh8;
 use super::collapse::{CollapseCosts, TreeShape, collapse};
@@ -15,7 +16,7 @@ use super::records::{
 };
 use super::sdf::sphere_trace;
 use super::shape::Shape;
-use super::small::{Small, small_scene};
+use super::small::{RAYS, RayLanes, Small, small_scene};
 use glam::{Mat3, Vec2, Vec3, Vec3A};
 use obvhs::{BvhBuildParams, aabb::Aabb};
 use std::time::Duration;
@@ -91,7 +92,9 @@ pub struct Geometry {
 /// fog comparison scenes (3 and 4 primitives, one a sphere enclosing the
 /// rest, whose box no ray misses) render 8% and 4% faster so than through
 /// the tree, with the same hits. Larger scenes take the quads' and boxes'
-/// lanes ([`small::SMALL_LIMIT`](super::small::SMALL_LIMIT)) or the tree.
+/// lanes ([`small::SMALL_LIMIT`](super::small::SMALL_LIMIT)) or the tree,
+/// and so do scenes this small of at least half quads (a quad light's
+/// surface alone, which the viewer tests packets of camera rays against).
 const LINEAR_LIMIT: usize = 4;
 /// Up to this many primitives, the BVH's leaves hold one primitive each.
 const SMALL_SCENE: usize = 64;
@@ -185,7 +188,8 @@ impl GeometryBuilder {
         let bounds = bounds.map(|b| (Vec3::from(b.min), Vec3::from(b.max)));
         // Without a tree, every primitive is tested for every ray.
         if records.len() <= LINEAR_LIMIT {
-            return Geometry { records, planes, unbounded, bounds, triangle_uvs, ..Geometry::default() };
+            let small = small_scene(&records);
+            return Geometry { records, planes, unbounded, bounds, triangle_uvs, small, ..Geometry::default() };
         }
         // A binary tree of one primitive a leaf, from which the collapse
         // chooses the leaves. obvhs's second reinsertion pass (run after
@@ -276,6 +280,59 @@ impl Geometry {
         (best.id != u32::MAX).then_some(best)
     }
 
+    /// `hits[i]` = `self.intersect(&rays[i], tmax[i])`, bit for bit, with
+    /// each ray's own bound: a small scene's rays eight at a time, each
+    /// quad and box against all eight at once; other scenes' one by one.
+    pub fn intersect_each(&self, rays: &[Ray], tmax: &[f32], hits: &mut [Option<Hit>]) {
+        assert!(rays.len() == tmax.len() && rays.len() == hits.len(), "one bound and one hit slot per ray");
+        match &self.small {
+            Some(small) => self.intersect_small_packets(small, rays, |i| tmax[i], hits),
+            None => {
+                for ((ray, &tmax), hit) in rays.iter().zip(tmax).zip(hits.iter_mut()) {
+                    *hit = self.intersect(ray, tmax);
+                }
+            }
+        }
+    }
+
+    /// The small scene's side of [`Geometry::intersect_packet`] and
+    /// [`Geometry::intersect_each`]: `hits[i]` = `self.intersect(&rays[i], tmax(i))`.
+    pub(super) fn intersect_small_packets(
+        &self,
+        small: &Small,
+        rays: &[Ray],
+        tmax: impl Fn(usize) -> f32,
+        hits: &mut [Option<Hit>],
+    ) {
+        for (start, (rays, hits)) in (0..).step_by(RAYS).zip(rays.chunks(RAYS).zip(hits.chunks_mut(RAYS))) {
+            let lanes = RayLanes::new(rays.iter().enumerate().map(|(k, r)| (r.origin, r.dir, tmax(start + k))));
+            let (mut best_t, mut best_id) = (lanes.tmax, [u32::MAX; RAYS]);
+            small.nearest_packet(&self.records, &lanes, &mut best_t, &mut best_id);
+            for (k, (ray, hit)) in rays.iter().zip(hits.iter_mut()).enumerate() {
+                let mut best = Hit { t: best_t[k], id: best_id[k] };
+                self.intersect_unbounded(ray, &mut best);
+                *hit = (best.id != u32::MAX).then_some(best);
+            }
+        }
+    }
+
+    /// The small scene's side of [`Geometry::occluded_packet`]: `blocked[i]`
+    /// is set where something blocks `segments[i]` (the unbounded
+    /// primitives already tested by the caller).
+    pub(super) fn occluded_small_packets(&self, small: &Small, segments: &[Segment], blocked: &mut [bool]) {
+        for (segments, blocked) in segments.chunks(RAYS).zip(blocked.chunks_mut(RAYS)) {
+            // Segments already blocked need no test: an empty lane.
+            let lanes = RayLanes::new(
+                segments.iter().zip(blocked.iter()).map(|(s, &b)| (s.origin, s.dir, if b { 0.0 } else { s.tmax })),
+            );
+            let mut found = [false; RAYS];
+            small.any_packet(&self.records, &lanes, &mut found);
+            for (b, found) in blocked.iter_mut().zip(found) {
+                *b |= found;
+            }
+        }
+    }
+
     /// Planes and unbounded SDFs, tested one by one after the bounded primitives.
     pub(super) fn intersect_unbounded(&self, ray: &Ray, best: &mut Hit) {
         let base = self.records.len() as u32;
@@ -324,6 +381,11 @@ impl Geometry {
     /// The tree, if the scene has one.
     pub(super) fn bvh(&self) -> Option<&Bvh8> {
         self.bvh.as_ref()
+    }
+
+    /// The quads' and boxes' lanes, if the scene is small enough for them.
+    pub(super) fn small(&self) -> Option<&Small> {
+        self.small.as_ref()
     }
 
     /// Whether a plane or unbounded SDF blocks the segment.

@@ -74,6 +74,10 @@ impl Geometry {
     #[doc(hidden)]
     pub fn intersect_packet_on(&self, lanes: LaneWidth, rays: &[Ray], tmax: f32, hits: &mut [Option<Hit>]) {
         assert!(lanes.available(), "this processor has no {lanes:?} lanes");
+        if let Some(small) = self.small() {
+            assert_eq!(rays.len(), hits.len(), "one hit slot per ray");
+            return self.intersect_small_packets(small, rays, |_| tmax, hits);
+        }
         match lanes {
             LaneWidth::Portable => self.intersect_packet_with::<Scalar4>(rays, tmax, hits),
             LaneWidth::Four => self.intersect_packet_with::<NativeLanes>(rays, tmax, hits),
@@ -207,6 +211,9 @@ impl Geometry {
         super::accel::count_shadow_rays(segments.len() as u64);
         for (s, b) in segments.iter().zip(blocked.iter_mut()) {
             *b = self.occluded_unbounded(s.origin, s.dir, s.tmax);
+        }
+        if let Some(small) = self.small() {
+            return self.occluded_small_packets(small, segments, blocked);
         }
         let Some(bvh) = self.bvh() else {
             for (s, b) in segments.iter().zip(blocked.iter_mut()) {

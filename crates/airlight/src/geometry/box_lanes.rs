@@ -13,6 +13,7 @@
 //! the distances are the same bit for bit and images do not change.
 
 use super::quad_lanes::any_below;
+use super::small::{RAYS, RayLanes, keep_if_before};
 use glam::{Affine3A, Vec3};
 
 /// Boxes per group: one SSE register per operation.
@@ -104,51 +105,89 @@ impl BoxLanes {
         }
         false
     }
+
+    /// Keeps, for each ray r of the packet, its nearest box hit in
+    /// (`best_t[r]`, `best_id[r]`) if it comes before what they hold: the
+    /// boxes one after another, each against all eight rays at once.
+    // One index across the packet's arrays.
+    #[allow(clippy::needless_range_loop)]
+    #[inline(always)]
+    pub fn nearest_in_packet(&self, rays: &RayLanes, best_t: &mut [f32; RAYS], best_id: &mut [u32; RAYS]) {
+        for g in &self.groups {
+            for (k, &id) in g.id.iter().enumerate().filter(|&(_, &id)| id != u32::MAX) {
+                for r in 0..RAYS {
+                    let t = distance(g, k, rays.origin(r), rays.dir(r), rays.tmax[r]);
+                    keep_if_before(t, id, &mut best_t[r], &mut best_id[r]);
+                }
+            }
+        }
+    }
+
+    /// Marks in `blocked` each ray of the packet that a box meets.
+    // One index across the packet's arrays.
+    #[allow(clippy::needless_range_loop)]
+    #[inline(always)]
+    pub fn any_in_packet(&self, rays: &RayLanes, blocked: &mut [bool; RAYS]) {
+        for g in &self.groups {
+            for (k, _) in g.id.iter().enumerate().filter(|&(_, &id)| id != u32::MAX) {
+                for r in 0..RAYS {
+                    blocked[r] |= distance(g, k, rays.origin(r), rays.dir(r), rays.tmax[r]) < rays.tmax[r];
+                }
+            }
+        }
+    }
 }
 
 /// Each lane's hit distance in (0, tmax), or infinity: the ray taken into
 /// the box's space and its slab test, lane by lane, without branches.
-// One index across the group's many arrays, and `&` rather than `&&`:
-// straight-line code the compiler vectorises.
-#[allow(clippy::needless_range_loop)]
 #[inline(always)]
 fn distances(g: &Group, o: Vec3, d: Vec3, tmax: f32) -> [f32; LANES] {
+    let mut out = [f32::INFINITY; LANES];
+    for (k, t) in out.iter_mut().enumerate() {
+        *t = distance(g, k, o, d, tmax);
+    }
+    out
+}
+
+/// Lane `k`'s hit distance in (0, tmax), or infinity: the ray taken into
+/// the box's space and its slab test, without branches. Inlined into a loop
+/// over the lanes (one ray, four boxes) or over rays (eight rays, one box),
+/// it is straight-line code the compiler vectorises.
+// `&` rather than `&&`: no branches.
+#[inline(always)]
+fn distance(g: &Group, k: usize, o: Vec3, d: Vec3, tmax: f32) -> f32 {
     // glam's comparisons, NaN and all: a NaN on the left yields the right.
     let lesser = |a: f32, b: f32| if a < b { a } else { b };
     let greater = |a: f32, b: f32| if a > b { a } else { b };
-    let mut out = [f32::INFINITY; LANES];
-    for k in 0..LANES {
-        let mut nearest = [0.0f32; 3];
-        let mut farthest = [0.0f32; 3];
-        for row in 0..3 {
-            let [x, y, z] = [g.axes[0][row][k], g.axes[1][row][k], g.axes[2][row][k]];
-            let turned_o = ((x * o.x + y * o.y) + z * o.z) + g.translation[row][k];
-            let turned_d = (x * d.x + y * d.y) + z * d.z;
-            let local_o = if g.turned[k] { turned_o } else { o[row] };
-            let local_d = if g.turned[k] { turned_d } else { d[row] };
-            let inv = 1.0 / local_d;
-            let t_a = (g.min[row][k] - local_o) * inv;
-            let t_b = (g.max[row][k] - local_o) * inv;
-            nearest[row] = lesser(t_a, t_b);
-            farthest[row] = greater(t_a, t_b);
-        }
-        // max_element and min_element: x against (y against z).
-        let near = greater(nearest[0], greater(nearest[1], nearest[2]));
-        let far = lesser(farthest[0], lesser(farthest[1], farthest[2]));
-        let near_in = (near > 0.0) & (near < tmax);
-        let far_in = (far > 0.0) & (far < tmax);
-        let t = if near > far {
-            f32::INFINITY
-        } else if near_in {
-            near
-        } else if far_in {
-            far
-        } else {
-            f32::INFINITY
-        };
-        out[k] = if g.id[k] == u32::MAX { f32::INFINITY } else { t };
+    let mut nearest = [0.0f32; 3];
+    let mut farthest = [0.0f32; 3];
+    for row in 0..3 {
+        let [x, y, z] = [g.axes[0][row][k], g.axes[1][row][k], g.axes[2][row][k]];
+        let turned_o = ((x * o.x + y * o.y) + z * o.z) + g.translation[row][k];
+        let turned_d = (x * d.x + y * d.y) + z * d.z;
+        let local_o = if g.turned[k] { turned_o } else { o[row] };
+        let local_d = if g.turned[k] { turned_d } else { d[row] };
+        let inv = 1.0 / local_d;
+        let t_a = (g.min[row][k] - local_o) * inv;
+        let t_b = (g.max[row][k] - local_o) * inv;
+        nearest[row] = lesser(t_a, t_b);
+        farthest[row] = greater(t_a, t_b);
     }
-    out
+    // max_element and min_element: x against (y against z).
+    let near = greater(nearest[0], greater(nearest[1], nearest[2]));
+    let far = lesser(farthest[0], lesser(farthest[1], farthest[2]));
+    let near_in = (near > 0.0) & (near < tmax);
+    let far_in = (far > 0.0) & (far < tmax);
+    let t = if near > far {
+        f32::INFINITY
+    } else if near_in {
+        near
+    } else if far_in {
+        far
+    } else {
+        f32::INFINITY
+    };
+    if g.id[k] == u32::MAX { f32::INFINITY } else { t }
 }
 
 #[cfg(test)]

@@ -12,6 +12,7 @@
 //! same order, so the hits are the same bit for bit as testing the quads
 //! one by one: images do not change, only the time.
 
+use super::small::{RAYS, RayLanes, keep_if_before};
 use glam::Vec3;
 
 /// Quads per group: two SSE registers per operation, enough independent
@@ -100,6 +101,38 @@ impl QuadLanes {
         }
         false
     }
+
+    /// Keeps, for each ray r of the packet, its nearest quad hit in
+    /// (`best_t[r]`, `best_id[r]`) if it comes before what they hold (see
+    /// [`keep_if_before`]): the quads one after another, each against all
+    /// eight rays at once.
+    // One index across the packet's arrays.
+    #[allow(clippy::needless_range_loop)]
+    #[inline(always)]
+    pub fn nearest_in_packet(&self, rays: &RayLanes, best_t: &mut [f32; RAYS], best_id: &mut [u32; RAYS]) {
+        for g in &self.groups {
+            for (k, &id) in g.id.iter().enumerate().filter(|&(_, &id)| id != u32::MAX) {
+                for r in 0..RAYS {
+                    let t = distance(g, k, rays.origin(r), rays.dir(r), rays.tmax[r]);
+                    keep_if_before(t, id, &mut best_t[r], &mut best_id[r]);
+                }
+            }
+        }
+    }
+
+    /// Marks in `blocked` each ray of the packet that a quad meets.
+    // One index across the packet's arrays.
+    #[allow(clippy::needless_range_loop)]
+    #[inline(always)]
+    pub fn any_in_packet(&self, rays: &RayLanes, blocked: &mut [bool; RAYS]) {
+        for g in &self.groups {
+            for (k, _) in g.id.iter().enumerate().filter(|&(_, &id)| id != u32::MAX) {
+                for r in 0..RAYS {
+                    blocked[r] |= distance(g, k, rays.origin(r), rays.dir(r), rays.tmax[r]) < rays.tmax[r];
+                }
+            }
+        }
+    }
 }
 
 /// Whether any lane's distance is below `tmax`: a loop without branches
@@ -115,38 +148,46 @@ pub(super) fn any_below<const N: usize>(distances: [f32; N], tmax: f32) -> bool 
 
 /// Each lane's hit distance in (0, tmax), or infinity: `intersect_quad`'s
 /// operations lane by lane, without branches (a miss selects infinity).
-// One index across the group's many arrays, and `&` rather than `&&` and
-// range `contains`: straight-line code the compiler vectorises.
-#[allow(clippy::needless_range_loop, clippy::manual_range_contains)]
 #[inline(always)]
 fn distances(g: &Group, o: Vec3, d: Vec3, tmax: f32) -> [f32; LANES] {
     let mut out = [f32::INFINITY; LANES];
-    for k in 0..LANES {
-        let [nx, ny, nz] = [g.normal[0][k], g.normal[1][k], g.normal[2][k]];
-        let [cx, cy, cz] = [g.corner[0][k], g.corner[1][k], g.corner[2][k]];
-        let [ux, uy, uz] = [g.edge_u[0][k], g.edge_u[1][k], g.edge_u[2][k]];
-        let [vx, vy, vz] = [g.edge_v[0][k], g.edge_v[1][k], g.edge_v[2][k]];
-        // n·d, n·(corner − o)
-        let denom = (nx * d.x) + (ny * d.y) + (nz * d.z);
-        let t = ((nx * (cx - o.x)) + (ny * (cy - o.y)) + (nz * (cz - o.z))) / denom;
-        // rel = o + d·t − corner
-        let (rx, ry, rz) = ((o.x + d.x * t) - cx, (o.y + d.y * t) - cy, (o.z + d.z * t) - cz);
-        // (rel × edge_v)·n and (edge_u × rel)·n
-        let (ax, ay, az) = (ry * vz - vy * rz, rz * vx - vz * rx, rx * vy - vx * ry);
-        let (bx, by, bz) = (uy * rz - ry * uz, uz * rx - rz * ux, ux * ry - rx * uy);
-        let alpha = ((ax * nx) + (ay * ny) + (az * nz)) * g.inv_nn[k];
-        let beta = ((bx * nx) + (by * ny) + (bz * nz)) * g.inv_nn[k];
-        // (A NaN denominator fails here, and its NaN t fails in the original.)
-        let hit = (denom.abs() >= 1e-20)
-            & (t > 0.0)
-            & (t < tmax)
-            & (alpha >= 0.0)
-            & (alpha <= 1.0)
-            & (beta >= 0.0)
-            & (beta <= 1.0);
-        out[k] = if hit { t } else { f32::INFINITY };
+    for (k, t) in out.iter_mut().enumerate() {
+        *t = distance(g, k, o, d, tmax);
     }
     out
+}
+
+/// Lane `k`'s hit distance in (0, tmax), or infinity: `intersect_quad`'s
+/// operations in its order, without branches (a miss selects infinity).
+/// Inlined into a loop over the lanes (one ray, eight quads) or over rays
+/// (eight rays, one quad), it is straight-line code the compiler vectorises.
+// `&` rather than `&&` and range `contains`: no branches.
+#[allow(clippy::manual_range_contains)]
+#[inline(always)]
+fn distance(g: &Group, k: usize, o: Vec3, d: Vec3, tmax: f32) -> f32 {
+    let [nx, ny, nz] = [g.normal[0][k], g.normal[1][k], g.normal[2][k]];
+    let [cx, cy, cz] = [g.corner[0][k], g.corner[1][k], g.corner[2][k]];
+    let [ux, uy, uz] = [g.edge_u[0][k], g.edge_u[1][k], g.edge_u[2][k]];
+    let [vx, vy, vz] = [g.edge_v[0][k], g.edge_v[1][k], g.edge_v[2][k]];
+    // n·d, n·(corner − o)
+    let denom = (nx * d.x) + (ny * d.y) + (nz * d.z);
+    let t = ((nx * (cx - o.x)) + (ny * (cy - o.y)) + (nz * (cz - o.z))) / denom;
+    // rel = o + d·t − corner
+    let (rx, ry, rz) = ((o.x + d.x * t) - cx, (o.y + d.y * t) - cy, (o.z + d.z * t) - cz);
+    // (rel × edge_v)·n and (edge_u × rel)·n
+    let (ax, ay, az) = (ry * vz - vy * rz, rz * vx - vz * rx, rx * vy - vx * ry);
+    let (bx, by, bz) = (uy * rz - ry * uz, uz * rx - rz * ux, ux * ry - rx * uy);
+    let alpha = ((ax * nx) + (ay * ny) + (az * nz)) * g.inv_nn[k];
+    let beta = ((bx * nx) + (by * ny) + (bz * nz)) * g.inv_nn[k];
+    // (A NaN denominator fails here, and its NaN t fails in the original.)
+    let hit = (denom.abs() >= 1e-20)
+        & (t > 0.0)
+        & (t < tmax)
+        & (alpha >= 0.0)
+        & (alpha <= 1.0)
+        & (beta >= 0.0)
+        & (beta <= 1.0);
+    if hit { t } else { f32::INFINITY }
 }
 
 #[cfg(test)]

@@ -24,6 +24,9 @@ use super::quad_lanes::QuadLanes;
 use super::records::{Prim, Record};
 use glam::{Affine3A, Vec3};
 
+mod packets;
+pub(in crate::geometry) use packets::{RAYS, RayLanes, keep_if_before};
+
 /// Up to this many primitives, at least half of them quads and none a
 /// signed distance field, single rays test the quads and boxes in SIMD lanes
 /// and the rest one by one rather than through the BVH: the Cornell box
@@ -66,6 +69,25 @@ impl Isa {
             }
         }
         Isa::Baseline
+    }
+}
+
+#[cfg(test)]
+impl Isa {
+    /// Every instruction set this processor runs.
+    fn available() -> Vec<Isa> {
+        let mut isas = vec![Isa::Baseline];
+        #[cfg(target_arch = "x86_64")]
+        {
+            use std::arch::is_x86_feature_detected as has;
+            if has!("avx2") && has!("fma") {
+                isas.push(Isa::Avx2);
+            }
+        }
+        if Isa::best() == Isa::Avx512 {
+            isas.push(Isa::Avx512);
+        }
+        isas
     }
 }
 
@@ -246,7 +268,7 @@ mod tests {
     use glam::vec3;
 
     /// A room of six quads with two boxes and a sphere in it.
-    fn room() -> Vec<Record> {
+    pub(super) fn room() -> Vec<Record> {
         let quad = |corner: Vec3, edge_u: Vec3, edge_v: Vec3| Prim::Quad { corner, edge_u, edge_v };
         let prims = [
             quad(vec3(-1.0, 0.0, -1.0), vec3(2.0, 0.0, 0.0), vec3(0.0, 0.0, 2.0)),
@@ -266,17 +288,7 @@ mod tests {
     fn every_instruction_set_gives_the_hits_of_each_record_tested_alone() {
         let records = room();
         let mut small = small_scene(&records).expect("a small scene");
-        let mut isas = vec![Isa::Baseline];
-        #[cfg(target_arch = "x86_64")]
-        {
-            use std::arch::is_x86_feature_detected as has;
-            if has!("avx2") && has!("fma") {
-                isas.push(Isa::Avx2);
-            }
-        }
-        if Isa::best() == Isa::Avx512 {
-            isas.push(Isa::Avx512);
-        }
+        let isas = Isa::available();
         let mut s = Sampler::for_pixel(3, 1, 4);
         let mut hits = 0;
         for i in 0..20_000 {
