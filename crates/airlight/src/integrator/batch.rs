@@ -5,10 +5,12 @@
 //! that each sample's radiance is the one-ray answer, bit for bit.
 
 use crate::Rgb;
-use crate::geometry::{Hit, Ray, Segment, offset_origin};
+use crate::geometry::{Hit, Ray, Segment, SurfaceHit, offset_origin};
+use crate::medium::Medium;
 use crate::sampling::Sampler;
 use crate::scene::Scene;
 use crate::scratch::with_scratch;
+use glam::Vec3;
 use std::cell::RefCell;
 
 /// A light's contribution to one sample, counted if its shadow ray is clear.
@@ -18,6 +20,88 @@ struct Candidate {
     contribution: Rgb,
     /// None: no shadow ray is traced and the light counts as hidden.
     segment: Option<Segment>,
+    /// The shadow ray's lifted origin, direction and the light's distance
+    /// (for a medium's transmittance).
+    origin: Vec3,
+    wi: Vec3,
+    distance: f32,
+}
+
+/// Direct light whose shadow rays are put off: the light terms of many
+/// shading points are kept, then their shadow rays traced as packets
+/// (grouped by light, so that a packet's rays run toward one light), then
+/// each visible term added to its point's sum in the order
+/// [`super::surface_radiance`] adds it: each point's light is the one-ray
+/// answer, bit for bit.
+#[derive(Default)]
+pub(crate) struct DeferredShadows {
+    candidates: Vec<Candidate>,
+    order: Vec<usize>,
+    segments: Vec<Segment>,
+    blocked_sorted: Vec<bool>,
+    blocked: Vec<bool>,
+}
+
+impl DeferredShadows {
+    /// Forgets the kept terms.
+    pub fn clear(&mut self) {
+        self.candidates.clear();
+    }
+
+    /// What [`super::surface_radiance`] gives at `surface` before its light
+    /// terms (the surface's emission); the terms are kept as sample
+    /// `sample`'s, for [`DeferredShadows::resolve`] to add. Draws from
+    /// `sampler` as `surface_radiance` does.
+    pub fn surface(
+        &mut self,
+        scene: &Scene,
+        ray: &Ray,
+        surface: &SurfaceHit,
+        sampler: &mut Sampler,
+        sample: usize,
+    ) -> Rgb {
+        super::for_each_light_term(scene, ray, surface, sampler, |light, s, contribution| {
+            let origin = offset_origin(surface.p, surface.n, s.wi);
+            let segment = scene.light_segment(surface.p, origin, s.wi, s.distance);
+            let (wi, distance) = (s.wi, s.distance);
+            self.candidates.push(Candidate { sample, light, contribution, segment, origin, wi, distance });
+        });
+        super::emitted(scene, ray, surface)
+    }
+
+    /// Traces the kept terms' shadow rays in `geometry` and adds each
+    /// visible term (through `medium`, if any, as `surface_radiance` does)
+    /// to its sample's `out[sample]`.
+    pub fn resolve(&mut self, scene: &Scene, medium: Option<&Medium>, out: &mut [Rgb]) {
+        let DeferredShadows { candidates, order, segments, blocked_sorted, blocked } = self;
+        // Shadow rays toward one light after another, each light's in the
+        // samples' order (neighbouring pixels).
+        order.clear();
+        order.extend((0..candidates.len()).filter(|&c| candidates[c].segment.is_some()));
+        order.sort_by_key(|&c| candidates[c].light);
+        segments.clear();
+        segments.extend(order.iter().filter_map(|&c| candidates[c].segment));
+        blocked_sorted.clear();
+        blocked_sorted.resize(segments.len(), false);
+        scene.geometry().occluded_packet(segments, blocked_sorted);
+        blocked.clear();
+        blocked.extend(candidates.iter().map(|c| c.segment.is_none()));
+        for (&c, &b) in order.iter().zip(blocked_sorted.iter()) {
+            blocked[c] = b;
+        }
+        // Each sample's lights in index order, as `surface_radiance` adds them.
+        for (c, candidate) in candidates.iter().enumerate() {
+            if blocked[c] {
+                continue;
+            }
+            let mut contribution = candidate.contribution;
+            if let Some(m) = medium {
+                let (origin, wi) = (candidate.origin, candidate.wi);
+                contribution *= m.transmittance(origin, wi, 0.0, scene.light_distance(candidate.distance));
+            }
+            out[candidate.sample] += contribution;
+        }
+    }
 }
 
 /// `out[i]` = what [`super::first_surface`] gives for `rays[i]` without a
@@ -35,60 +119,25 @@ pub fn first_surface_batch(scene: &Scene, rays: &[Ray], samplers: &mut [Sampler]
 #[derive(Default)]
 struct Scratch {
     hits: Vec<Option<Hit>>,
-    candidates: Vec<Candidate>,
-    order: Vec<usize>,
-    segments: Vec<Segment>,
-    blocked_sorted: Vec<bool>,
-    blocked: Vec<bool>,
+    shadows: DeferredShadows,
 }
 
 /// [`first_surface_batch`] in `scratch`'s buffers.
 fn trace_batch(scene: &Scene, rays: &[Ray], samplers: &mut [Sampler], out: &mut [Rgb], scratch: &mut Scratch) {
-    let Scratch { hits, candidates, order, segments, blocked_sorted, blocked } = scratch;
+    let Scratch { hits, shadows } = scratch;
     let geometry = scene.geometry();
     hits.clear();
     hits.resize(rays.len(), None);
     geometry.intersect_packet(rays, f32::INFINITY, hits);
-    candidates.clear();
+    shadows.clear();
     for (k, ((ray, hit), sampler)) in rays.iter().zip(hits.iter()).zip(samplers.iter_mut()).enumerate() {
-        let Some(hit) = *hit else {
-            out[k] = scene.settings().background;
-            continue;
+        out[k] = match *hit {
+            // What `surface_radiance` computes, with its shadow rays put off.
+            Some(hit) => shadows.surface(scene, ray, &geometry.surface(ray, hit), sampler, k),
+            None => scene.settings().background,
         };
-        let surface = geometry.surface(ray, hit);
-        // What `surface_radiance` computes, with its shadow rays put off.
-        out[k] = super::emitted(scene, ray, &surface);
-        super::for_each_light_term(scene, ray, &surface, sampler, |index, sample, contribution| {
-            let origin = offset_origin(surface.p, surface.n, sample.wi);
-            candidates.push(Candidate {
-                sample: k,
-                light: index,
-                contribution,
-                segment: scene.light_segment(surface.p, origin, sample.wi, sample.distance),
-            });
-        });
     }
-    // Shadow rays toward one light after another, each light's in the
-    // samples' order (neighbouring pixels).
-    order.clear();
-    order.extend((0..candidates.len()).filter(|&c| candidates[c].segment.is_some()));
-    order.sort_by_key(|&c| candidates[c].light);
-    segments.clear();
-    segments.extend(order.iter().filter_map(|&c| candidates[c].segment));
-    blocked_sorted.clear();
-    blocked_sorted.resize(segments.len(), false);
-    geometry.occluded_packet(segments, blocked_sorted);
-    blocked.clear();
-    blocked.extend(candidates.iter().map(|c| c.segment.is_none()));
-    for (&c, &b) in order.iter().zip(blocked_sorted.iter()) {
-        blocked[c] = b;
-    }
-    // Each sample's lights in index order, as `surface_radiance` adds them.
-    for (c, candidate) in candidates.iter().enumerate() {
-        if !blocked[c] {
-            out[candidate.sample] += candidate.contribution;
-        }
-    }
+    shadows.resolve(scene, None, out);
     for (k, hit) in hits.iter().enumerate() {
         if hit.is_some() {
             // `first_surface` adds its extra term, zero here; adding it

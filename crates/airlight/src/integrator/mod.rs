@@ -14,6 +14,7 @@ mod raymarch;
 mod stochastic;
 
 pub use analytic::{Analytic, AnalyticOptions};
+pub(crate) use batch::DeferredShadows;
 pub use batch::first_surface_batch;
 pub use direct::Direct;
 pub use equiangular::Equiangular;

@@ -22,14 +22,16 @@ use super::Preview;
 use crate::Camera;
 use crate::Rgb;
 use crate::film::Image;
-use crate::geometry::{Geometry, GeometryBuilder, Ray, SurfaceHit};
-use crate::integrator::{surface_radiance, through_medium};
+use crate::geometry::{Geometry, GeometryBuilder, Hit, Ray, SurfaceHit};
+use crate::integrator::{DeferredShadows, through_medium};
 use crate::radiosity::Radiosity;
 use crate::render::film_sample;
 use crate::sampling::Sampler;
 use crate::scene::{PixelFilter, Scene};
+use crate::scratch::with_scratch;
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;
+use std::cell::RefCell;
 use std::f32::consts::FRAC_1_PI;
 
 /// One pixel's camera ray and what it meets among the objects.
@@ -158,9 +160,10 @@ impl FirstSample {
         let (w, h) = (scene.settings().width, scene.settings().height);
         let mut image = Image::new(w, h);
         image.pixels.par_chunks_mut(w.max(1) as usize).enumerate().for_each(|(y, row)| {
-            for (x, out) in row.iter_mut().enumerate() {
-                *out = self.shade(scene, solution, preview, &lights, (x, y));
+            thread_local! {
+                static SCRATCH: RefCell<RowScratch> = RefCell::new(RowScratch::default());
             }
+            with_scratch(&SCRATCH, |scratch| self.shade_row(scene, solution, preview, &lights, y, row, scratch));
         });
         image
     }
@@ -188,9 +191,11 @@ impl FirstSample {
                     .unzip();
                 let mut rays = Vec::with_capacity(texels.len());
                 camera.rays_into(&films, &lenses, &mut rays);
-                for (x, (texel, ray)) in texels.iter_mut().zip(rays).enumerate() {
+                let mut hits = vec![None; rays.len()];
+                objects.intersect_packet(&rays, f32::INFINITY, &mut hits);
+                for (x, ((texel, ray), hit)) in texels.iter_mut().zip(rays).zip(hits).enumerate() {
                     *texel = Texel::missed(ray);
-                    if let Some(hit) = objects.intersect(&ray, f32::INFINITY) {
+                    if let Some(hit) = hit {
                         let surface = objects.surface(&ray, hit);
                         texel.hit = Some(surface);
                         texel.t = hit.t;
@@ -228,10 +233,12 @@ impl FirstSample {
         self.anchors.resize(columns * rows, Anchor::default());
         let texels = &self.texels;
         self.anchors.par_chunks_mut(columns.max(1)).enumerate().for_each(|(j, row)| {
+            let texel = |i: usize| &texels[2 * j * w + 2 * i];
+            let behind_light = lights_in_front(lights, (0..row.len()).map(texel));
             for (i, anchor) in row.iter_mut().enumerate() {
-                let texel = &texels[2 * j * w + 2 * i];
+                let texel = texel(i);
                 *anchor = match &texel.hit {
-                    Some(_) if lights.intersect(&texel.ray, texel.t).is_some() => Anchor::default(),
+                    Some(_) if behind_light[i].is_some() => Anchor::default(),
                     Some(s) => {
                         let n = s.facing(texel.ray.dir);
                         // The same bits as the exact fill's weights summed.
@@ -273,30 +280,48 @@ impl FirstSample {
         Some(sum / (nx * ny) as f32)
     }
 
-    /// What `preview.radiance` gives for pixel (x, y)'s sample 0.
-    fn shade(
+    /// What `preview.radiance` gives for row `y`'s sample 0, into `row`:
+    /// the camera rays tested against the lights' surfaces together, each
+    /// pixel's light terms gathered and their shadow rays traced together,
+    /// then each pixel finished (indirect light, medium) with its own
+    /// sampler, which draws what the integrator's would.
+    #[allow(clippy::too_many_arguments)]
+    fn shade_row(
         &self,
         scene: &Scene,
         solution: Option<&Radiosity>,
         preview: &Preview,
         lights: &Geometry,
-        (x, y): (usize, usize),
-    ) -> Rgb {
-        let (w, h) = (scene.settings().width as usize, scene.settings().height as usize);
-        let index = y * w + x;
-        let texel = &self.texels[index];
-        let ray = &texel.ray;
-        let mut sampler = first_sampler(scene, index as u64);
-        // The camera's draws, made by the renderer before the integrator's.
-        sampler.next2();
-        sampler.next2();
-        let medium = scene.medium();
-        let (surface, t_end) = match lights.intersect(ray, texel.t) {
-            // A light's surface in front of the objects (it reflects nothing).
-            Some(hit) => (surface_radiance(scene, ray, &lights.surface(ray, hit), &mut sampler, medium), hit.t),
-            None => match &texel.hit {
-                Some(s) => {
-                    let mut l = surface_radiance(scene, ray, s, &mut sampler, medium);
+        y: usize,
+        row: &mut [Rgb],
+        scratch: &mut RowScratch,
+    ) {
+        let (w, h) = (row.len(), self.texels.len() / row.len());
+        let texels = &self.texels[y * w..(y + 1) * w];
+        let RowScratch { samplers, shadows } = scratch;
+        let light_hits = lights_in_front(lights, texels.iter());
+        samplers.clear();
+        shadows.clear();
+        for (x, ((texel, light_hit), out)) in texels.iter().zip(&light_hits).zip(row.iter_mut()).enumerate() {
+            let mut sampler = first_sampler(scene, (y * w + x) as u64);
+            // The camera's draws, made by the renderer before the integrator's.
+            sampler.next2();
+            sampler.next2();
+            let ray = &texel.ray;
+            *out = match (light_hit, &texel.hit) {
+                // A light's surface in front of the objects (it reflects nothing).
+                (Some(hit), _) => shadows.surface(scene, ray, &lights.surface(ray, *hit), &mut sampler, x),
+                (None, Some(s)) => shadows.surface(scene, ray, s, &mut sampler, x),
+                (None, None) => scene.settings().background,
+            };
+            samplers.push(sampler);
+        }
+        shadows.resolve(scene, scene.medium(), row);
+        for (x, ((texel, light_hit), out)) in texels.iter().zip(&light_hits).zip(row.iter_mut()).enumerate() {
+            let ray = &texel.ray;
+            let t_end = match (light_hit, &texel.hit) {
+                (Some(hit), _) => hit.t,
+                (None, Some(s)) => {
                     if let Some(solution) = solution {
                         let e = match texel.indirect {
                             Indirect::Own => own_irradiance(texel, &self.weights[y], solution.indirect_irradiance()),
@@ -304,19 +329,36 @@ impl FirstSample {
                             Indirect::Anchors => self.between_anchors(solution, s, ray, (x, y), (w, h)),
                         };
                         if let Some(e) = e {
-                            l += texel.albedo * e;
+                            *out += texel.albedo * e;
                         }
                     }
-                    (l, texel.t)
+                    texel.t
                 }
-                None => (scene.settings().background, scene.settings().max_distance),
-            },
-        };
-        let l = through_medium(scene, ray, surface, t_end, &mut sampler, |medium, length, sampler| {
-            preview.glow(scene, medium, ray, length, sampler)
-        });
-        if l.is_finite() { l } else { Rgb::ZERO }
+                (None, None) => scene.settings().max_distance,
+            };
+            let l = through_medium(scene, ray, *out, t_end, &mut samplers[x], |medium, length, sampler| {
+                preview.glow(scene, medium, ray, length, sampler)
+            });
+            *out = if l.is_finite() { l } else { Rgb::ZERO };
+        }
     }
+}
+
+/// What [`FirstSample::shade_row`] works in.
+#[derive(Default)]
+struct RowScratch {
+    /// Each pixel's generator, between its light terms and its medium.
+    samplers: Vec<Sampler>,
+    shadows: DeferredShadows,
+}
+
+/// Where each texel's camera ray meets the lights' surfaces before its
+/// object, traced together.
+fn lights_in_front<'t>(lights: &Geometry, texels: impl Iterator<Item = &'t Texel>) -> Vec<Option<Hit>> {
+    let (rays, tmax): (Vec<Ray>, Vec<f32>) = texels.map(|texel| (texel.ray, texel.t)).unzip();
+    let mut hits = vec![None; rays.len()];
+    lights.intersect_each(&rays, &tmax, &mut hits);
+    hits
 }
 
 /// A texel's irradiance from its own lookup weights (in its row's `list`),
