@@ -8,18 +8,12 @@
 //! holds hits against the scene's objects only, and each frame tests the
 //! camera rays against the lights' surfaces where they are now.
 //!
-//! A moving camera refills the cache every frame, and there the lookup's
-//! weights are the largest part of the work. [`Fill::Sparse`] looks them
-//! up only at every other pixel in each direction (the anchors), and the
-//! pixels between take the mean of their neighbouring anchors' indirect
-//! irradiance where those lie on the same surface close by: bilinear
-//! interpolation across the screen of a quantity that varies over the
-//! kernel's radius (a patch and a half), not over a pixel. Direct light,
-//! shadows and edges stay per pixel. The viewer uses it while the camera
-//! moves and goes back to [`Fill::Exact`] when it stops.
+//! A moving camera would refill the cache every frame: its frames take
+//! [`Fill::Sparse`] instead, which interpolates the indirect light between
+//! anchors and keeps no texels (`sparse.rs`).
 
 use super::Preview;
-use crate::Camera;
+use super::sparse::{Anchor, anchor_index, between_anchors};
 use crate::Rgb;
 use crate::film::Image;
 use crate::geometry::{Geometry, GeometryBuilder, Hit, Ray, SurfaceHit};
@@ -29,6 +23,7 @@ use crate::render::film_sample;
 use crate::sampling::Sampler;
 use crate::scene::{PixelFilter, Scene};
 use crate::scratch::with_scratch;
+use crate::{Camera, CameraRays};
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 use std::cell::RefCell;
@@ -36,24 +31,24 @@ use std::f32::consts::FRAC_1_PI;
 
 /// One pixel's camera ray and what it meets among the objects.
 #[derive(Clone, Copy)]
-struct Texel {
-    ray: Ray,
-    hit: Option<SurfaceHit>,
+pub(super) struct Texel {
+    pub ray: Ray,
+    pub hit: Option<SurfaceHit>,
     /// The hit's distance, or how far the preview follows a ray that hits nothing.
-    t: f32,
+    pub t: f32,
     /// The diffuse albedo at the hit, times 1/π.
-    albedo: Rgb,
+    pub albedo: Rgb,
     /// Lookup weights: `weights[row][start..start + len]`, times `scale`
     /// (for [`Indirect::Own`]).
     start: u32,
     len: u32,
     scale: f32,
-    indirect: Indirect,
+    pub indirect: Indirect,
 }
 
 impl Texel {
     /// A texel whose camera ray meets no object (yet).
-    fn missed(ray: Ray) -> Texel {
+    pub fn missed(ray: Ray) -> Texel {
         let (start, len, scale) = (0, 0, 0.0);
         Texel { ray, hit: None, t: f32::INFINITY, albedo: Rgb::ZERO, start, len, scale, indirect: Indirect::Own }
     }
@@ -61,14 +56,13 @@ impl Texel {
 
 /// Where a texel's indirect irradiance comes from.
 #[derive(Clone, Copy, PartialEq, Eq)]
-enum Indirect {
+pub(super) enum Indirect {
     /// Its own lookup's weights.
     Own,
-    /// A sparse fill's anchor: its irradiance is looked up once per frame
-    /// by [`FirstSample::update_anchors`] (the weights, used once, are not
-    /// kept).
+    /// A sparse render's anchor: its irradiance is looked up once per
+    /// frame, before the rows are shaded (`sparse.rs`).
     Anchor,
-    /// A sparse fill's texel between anchors: the mean of its anchors'
+    /// A sparse render's texel between anchors: the mean of its anchors'
     /// irradiance (left and right on an anchor row; above and below on an
     /// anchor column; the four diagonal ones elsewhere) when all of them
     /// lie on its surface near its hit; else a lookup of its own when it is
@@ -77,7 +71,7 @@ enum Indirect {
     Anchors,
 }
 
-/// How a refill of the cache finds the radiosity lookup's weights.
+/// How the first sample finds the radiosity lookup's weights.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Fill {
     /// Each pixel's own: the first sample exactly as the renderer makes it.
@@ -85,18 +79,10 @@ pub enum Fill {
     /// Each pixel's own at even columns of even rows (the anchors); a
     /// pixel between takes the mean of its neighbouring anchors'
     /// irradiance where all of them hit its surface close by, and looks up
-    /// its own elsewhere (see the module documentation).
+    /// its own elsewhere. The interpolated quantity varies over the kernel's
+    /// radius (a patch and a half), not over a pixel; direct light, shadows
+    /// and edges stay per pixel. A sparse render keeps no texels.
     Sparse,
-}
-
-/// What the texels between anchors read of one, packed: its hit's point,
-/// its normal on the ray's side, and the indirect irradiance there this
-/// frame (None without a hit or without a patch near).
-#[derive(Clone, Copy, Default)]
-struct Anchor {
-    p: Vec3,
-    n: Vec3,
-    e: Option<Rgb>,
 }
 
 /// What [`Camera`], size, seed and filter the cache was made for.
@@ -105,19 +91,17 @@ type Key = (Camera, u32, u32, u64, PixelFilter);
 /// Sample 0 of every pixel of the preview, reusing camera-ray hits and
 /// lookup weights while the view stays the same (see the module docs).
 pub struct FirstSample {
-    key: Option<Key>,
-    /// How the texels were filled.
-    fill: Fill,
+    /// What the texels were made for (None while they hold none: a moving
+    /// camera's frames keep none).
+    pub(super) key: Option<Key>,
     /// The scene's objects without the lights' surfaces.
-    objects: Geometry,
+    pub(super) objects: Geometry,
     texels: Vec<Texel>,
-    /// Per image row, the lookup weights its texels index (an exact fill's
-    /// only: a sparse fill's anchors look their irradiance up each frame).
-    /// Kept, with the texels, from frame to frame.
+    /// Per image row, the lookup weights its texels index. Kept, with the
+    /// texels, from frame to frame.
     weights: Vec<Vec<(u32, f32)>>,
-    /// After a sparse fill, each anchor's hit and its indirect irradiance
-    /// this frame, (w/2) × (h/2) rounded up.
-    anchors: Vec<Anchor>,
+    /// A moving camera's frame's anchors (see `sparse.rs`).
+    pub(super) anchors: Vec<Anchor>,
 }
 
 impl FirstSample {
@@ -125,7 +109,6 @@ impl FirstSample {
     pub fn new(scene: &Scene) -> Self {
         FirstSample {
             key: None,
-            fill: Fill::Exact,
             objects: scene.objects_geometry(),
             texels: Vec::new(),
             weights: Vec::new(),
@@ -133,172 +116,159 @@ impl FirstSample {
         }
     }
 
-    /// Whether the next [`FirstSample::render`] with `fill` reuses the
-    /// cached hits: a sparse fill serves a sparse render only.
-    pub fn is_valid_for(&self, scene: &Scene, fill: Fill) -> bool {
-        self.key == Some(key(scene)) && (self.fill == Fill::Exact || fill == Fill::Sparse)
+    /// Whether the next [`FirstSample::render`] reuses cached hits (an
+    /// exact fill's, which serve either fill; a sparse render keeps none).
+    pub fn is_valid_for(&self, scene: &Scene, _fill: Fill) -> bool {
+        self.key == Some(key(scene))
     }
 
     /// Sample 0 of every pixel with `preview` (which must hold `solution`
-    /// and be made for the scene's current lights), computed from the
-    /// cache, which is refilled first when the camera, image size, seed or
-    /// filter changed, or when an exact image is asked of a sparse fill.
-    /// With [`Fill::Exact`] it is the image `render_samples(scene, preview,
-    /// 0, 1, ..)` gives; with [`Fill::Sparse`] its indirect light is
-    /// interpolated between anchors (a new fill is sparse; a kept exact one
-    /// is used as it is).
+    /// and be made for the scene's current lights). With [`Fill::Exact`]
+    /// it is the image `render_samples(scene, preview, 0, 1, ..)` gives,
+    /// from the cache, which is refilled first when the camera, image size,
+    /// seed or filter changed. With [`Fill::Sparse`] and no cache for this
+    /// view, its indirect light is interpolated between anchors, and each
+    /// row's texels are made, shaded and dropped (a kept exact fill is
+    /// used as it is).
     pub fn render(&mut self, scene: &Scene, solution: Option<&Radiosity>, preview: &Preview, fill: Fill) -> Image {
+        if fill == Fill::Sparse && !self.is_valid_for(scene, fill) {
+            return self.render_sparse(scene, solution, preview);
+        }
         if !self.is_valid_for(scene, fill) {
-            self.fill(scene, solution, fill);
+            self.fill(scene, solution);
         }
         let lights = light_surfaces(scene);
-        if self.fill == Fill::Sparse
-            && let Some(solution) = solution
-        {
-            self.update_anchors(solution, &lights, scene.settings().width as usize);
-        }
         let (w, h) = (scene.settings().width, scene.settings().height);
         let mut image = Image::new(w, h);
         image.pixels.par_chunks_mut(w.max(1) as usize).enumerate().for_each(|(y, row)| {
-            thread_local! {
-                static SCRATCH: RefCell<RowScratch> = RefCell::new(RowScratch::default());
-            }
-            with_scratch(&SCRATCH, |scratch| self.shade_row(scene, solution, preview, &lights, y, row, scratch));
+            let texels = &self.texels[y * row.len()..(y + 1) * row.len()];
+            with_scratch(&ROWS, |scratch| {
+                let rows = Rows { scene, solution, preview, lights: &lights, anchors: &[] };
+                rows.shade(y, texels, &self.weights[y], row, &mut scratch.shading)
+            });
         });
         image
     }
 
-    fn fill(&mut self, scene: &Scene, solution: Option<&Radiosity>, fill: Fill) {
+    /// Refills the cache for the scene's view: every pixel's texel with
+    /// its own lookup weights.
+    fn fill(&mut self, scene: &Scene, solution: Option<&Radiosity>) {
+        self.key = None;
         let s = scene.settings();
         let (w, h) = (s.width as usize, s.height as usize);
-        if self.texels.len() != w * h {
-            self.texels = vec![Texel::missed(Ray::new(Vec3::ZERO, Vec3::Z)); w * h];
-        }
+        self.texels.resize(w * h, Texel::missed(Ray::new(Vec3::ZERO, Vec3::Z)));
         self.weights.resize_with(h, Vec::new);
-        let anchor = |x: usize, y: usize| x.is_multiple_of(2) && y.is_multiple_of(2);
         let objects = &self.objects;
         let camera = scene.camera().rays(s.width, s.height);
         self.texels.par_chunks_mut(w.max(1)).zip(self.weights.par_iter_mut()).enumerate().for_each(
             |(y, (texels, weights))| {
+                with_scratch(&ROWS, |scratch| {
+                    trace_texels(scene, objects, &camera, y, 0..w, 1, &mut scratch.tracing, texels);
+                });
                 weights.clear();
-                // The row's camera rays, made together. The preview's camera
-                // numbers are not stratified: two independent pairs, which
-                // `shade` skips.
-                let (films, lenses): (Vec<Vec2>, Vec<Vec2>) = (0..texels.len())
-                    .map(|x| {
-                        film_sample(s.filter, false, x as u32, y as u32, &mut first_sampler(scene, (y * w + x) as u64))
-                    })
-                    .unzip();
-                let mut rays = Vec::with_capacity(texels.len());
-                camera.rays_into(&films, &lenses, &mut rays);
-                let mut hits = vec![None; rays.len()];
-                objects.intersect_packet(&rays, f32::INFINITY, &mut hits);
-                for (x, ((texel, ray), hit)) in texels.iter_mut().zip(rays).zip(hits).enumerate() {
-                    *texel = Texel::missed(ray);
-                    if let Some(hit) = hit {
-                        let surface = objects.surface(&ray, hit);
-                        texel.hit = Some(surface);
-                        texel.t = hit.t;
-                        texel.albedo = scene.material_at(&surface).albedo(surface.p, surface.n) * FRAC_1_PI;
-                        if let Some(solution) = solution {
-                            if fill == Fill::Exact {
-                                let n = surface.facing(ray.dir);
-                                (texel.start, texel.len, texel.scale) = own_weights(solution, surface.p, n, weights);
-                            } else if anchor(x, y) {
-                                texel.indirect = Indirect::Anchor;
-                            } else {
-                                texel.indirect = Indirect::Anchors;
-                            }
+                if let Some(solution) = solution {
+                    for texel in texels.iter_mut() {
+                        if let Some(surface) = &texel.hit {
+                            let n = surface.facing(texel.ray.dir);
+                            (texel.start, texel.len, texel.scale) = own_weights(solution, surface.p, n, weights);
                         }
                     }
                 }
             },
         );
         self.key = Some(key(scene));
-        self.fill = fill;
     }
+}
 
-    /// Each anchor's hit and indirect irradiance with the solution's values
-    /// now, for the anchor and the texels between to read. Looked up here
-    /// rather than summed from weights kept by the fill: a moving camera's
-    /// fill serves one frame, and writing the weights only to read them
-    /// once cost 1.6–1.8% of a flying frame.
-    ///
-    /// An anchor whose camera ray meets a light's surface before its object
-    /// lends nothing: the ceiling behind a light is in the light's shadow,
-    /// unlike the ceiling beside it that the pixels between may see.
-    fn update_anchors(&mut self, solution: &Radiosity, lights: &Geometry, w: usize) {
-        let columns = w.div_ceil(2);
-        let rows = self.texels.len().checked_div(w).unwrap_or(0).div_ceil(2);
-        self.anchors.resize(columns * rows, Anchor::default());
-        let texels = &self.texels;
-        self.anchors.par_chunks_mut(columns.max(1)).enumerate().for_each(|(j, row)| {
-            let texel = |i: usize| &texels[2 * j * w + 2 * i];
-            let behind_light = lights_in_front(lights, (0..row.len()).map(texel));
-            for (i, anchor) in row.iter_mut().enumerate() {
-                let texel = texel(i);
-                *anchor = match &texel.hit {
-                    Some(_) if behind_light[i].is_some() => Anchor::default(),
-                    Some(s) => {
-                        let n = s.facing(texel.ray.dir);
-                        // The same bits as the exact fill's weights summed.
-                        Anchor { p: s.p, n, e: solution.irradiance_at(s.p, n) }
-                    }
-                    None => Anchor::default(),
-                };
-            }
-        });
+/// The texels of row `y` at columns `first, first + step, …` below `w`
+/// (into `out`, one per column): camera rays made together and traced as
+/// a packet, with their hits' surfaces and albedos (lookup weights and
+/// indirect sources are the caller's to set).
+#[allow(clippy::too_many_arguments)]
+pub(super) fn trace_texels(
+    scene: &Scene,
+    objects: &Geometry,
+    camera: &CameraRays,
+    y: usize,
+    columns: std::ops::Range<usize>,
+    step: usize,
+    scratch: &mut Tracing,
+    out: &mut [Texel],
+) {
+    let s = scene.settings();
+    let w = s.width as usize;
+    let Tracing { films, lenses, rays, hits } = scratch;
+    // The preview's camera numbers are not stratified: two independent
+    // pairs, which `Rows::shade` skips.
+    films.clear();
+    lenses.clear();
+    for x in columns.step_by(step) {
+        let mut sampler = first_sampler(scene, (y * w + x) as u64);
+        let (film, lens) = film_sample(s.filter, false, x as u32, y as u32, &mut sampler);
+        films.push(film);
+        lenses.push(lens);
     }
-
-    /// The indirect irradiance at pixel (x, y) of a `w`×`h` sparse fill,
-    /// a texel between anchors whose ray hit `surface` (see
-    /// [`Indirect::Anchors`]).
-    fn between_anchors(
-        &self,
-        solution: &Radiosity,
-        surface: &SurfaceHit,
-        ray: &Ray,
-        at: (usize, usize),
-        size: (usize, usize),
-    ) -> Option<Rgb> {
-        let ((x, y), (w, h)) = (at, size);
-        let (n, radius) = (surface.facing(ray.dir), solution.lookup().radius());
-        let around = |k: usize| if k.is_multiple_of(2) { ([k, k], 1) } else { ([k - 1, k + 1], 2) };
-        let ((xs, nx), (ys, ny)) = (around(x), around(y));
-        let mut sum = Rgb::ZERO;
-        for &ay in &ys[..ny] {
-            for &ax in &xs[..nx] {
-                let anchor = (ax < w && ay < h).then(|| self.anchors[anchor_index(ax, ay, w)]);
-                match anchor {
-                    Some(Anchor { p, n: m, e: Some(e) }) if same_surface(surface.p, n, p, m, radius) => sum += e,
-                    // An edge of the image, a silhouette or a crease
-                    // between: interpolation would reach across it.
-                    _ => return solution.irradiance_at(surface.p, n),
-                }
-            }
+    rays.clear();
+    camera.rays_into(films, lenses, rays);
+    hits.clear();
+    hits.resize(rays.len(), None);
+    objects.intersect_packet(rays, f32::INFINITY, hits);
+    for ((texel, &ray), &hit) in out.iter_mut().zip(rays.iter()).zip(hits.iter()) {
+        *texel = Texel::missed(ray);
+        if let Some(hit) = hit {
+            let surface = objects.surface(&ray, hit);
+            texel.hit = Some(surface);
+            texel.t = hit.t;
+            texel.albedo = scene.material_at(&surface).albedo(surface.p, surface.n) * FRAC_1_PI;
         }
-        Some(sum / (nx * ny) as f32)
     }
+}
 
-    /// What `preview.radiance` gives for row `y`'s sample 0, into `row`:
-    /// the camera rays tested against the lights' surfaces together, each
+/// What [`trace_texels`] works in.
+#[derive(Default)]
+pub(super) struct Tracing {
+    films: Vec<Vec2>,
+    lenses: Vec<Vec2>,
+    rays: Vec<Ray>,
+    hits: Vec<Option<Hit>>,
+}
+
+/// A rendering thread's buffers, kept from row to row.
+#[derive(Default)]
+pub(super) struct RowScratch {
+    pub tracing: Tracing,
+    pub shading: Shading,
+    /// A sparse render's row of texels.
+    pub texels: Vec<Texel>,
+}
+
+thread_local! {
+    pub(super) static ROWS: RefCell<RowScratch> = RefCell::new(RowScratch::default());
+}
+
+/// What shading a row reads: the scene, its radiosity solution, the
+/// preview, the lights' surfaces where they are now, and a sparse frame's
+/// anchors (none for an exact fill).
+pub(super) struct Rows<'a> {
+    pub scene: &'a Scene,
+    pub solution: Option<&'a Radiosity>,
+    pub preview: &'a Preview<'a>,
+    pub lights: &'a Geometry,
+    pub anchors: &'a [Anchor],
+}
+
+impl Rows<'_> {
+    /// What `preview.radiance` gives for row `y`'s sample 0, into `row`,
+    /// from the row's `texels` (and the lookup `weights` they index): the
+    /// camera rays tested against the lights' surfaces together, each
     /// pixel's light terms gathered and their shadow rays traced together,
     /// then each pixel finished (indirect light, medium) with its own
     /// sampler, which draws what the integrator's would.
-    #[allow(clippy::too_many_arguments)]
-    fn shade_row(
-        &self,
-        scene: &Scene,
-        solution: Option<&Radiosity>,
-        preview: &Preview,
-        lights: &Geometry,
-        y: usize,
-        row: &mut [Rgb],
-        scratch: &mut RowScratch,
-    ) {
-        let (w, h) = (row.len(), self.texels.len() / row.len());
-        let texels = &self.texels[y * w..(y + 1) * w];
-        let RowScratch { samplers, shadows } = scratch;
+    pub fn shade(&self, y: usize, texels: &[Texel], weights: &[(u32, f32)], row: &mut [Rgb], scratch: &mut Shading) {
+        let Rows { scene, solution, preview, lights, anchors } = *self;
+        let w = row.len();
+        let h = scene.settings().height as usize;
+        let Shading { samplers, shadows } = scratch;
         let light_hits = lights_in_front(lights, texels.iter());
         samplers.clear();
         shadows.clear();
@@ -324,9 +294,9 @@ impl FirstSample {
                 (None, Some(s)) => {
                     if let Some(solution) = solution {
                         let e = match texel.indirect {
-                            Indirect::Own => own_irradiance(texel, &self.weights[y], solution.indirect_irradiance()),
-                            Indirect::Anchor => self.anchors[anchor_index(x, y, w)].e,
-                            Indirect::Anchors => self.between_anchors(solution, s, ray, (x, y), (w, h)),
+                            Indirect::Own => own_irradiance(texel, weights, solution.indirect_irradiance()),
+                            Indirect::Anchor => anchors[anchor_index(x, y, w)].e,
+                            Indirect::Anchors => between_anchors(anchors, solution, s, ray, (x, y), (w, h)),
                         };
                         if let Some(e) = e {
                             *out += texel.albedo * e;
@@ -344,9 +314,9 @@ impl FirstSample {
     }
 }
 
-/// What [`FirstSample::shade_row`] works in.
+/// What [`Rows::shade`] works in.
 #[derive(Default)]
-struct RowScratch {
+pub(super) struct Shading {
     /// Each pixel's generator, between its light terms and its medium.
     samplers: Vec<Sampler>,
     shadows: DeferredShadows,
@@ -354,7 +324,7 @@ struct RowScratch {
 
 /// Where each texel's camera ray meets the lights' surfaces before its
 /// object, traced together.
-fn lights_in_front<'t>(lights: &Geometry, texels: impl Iterator<Item = &'t Texel>) -> Vec<Option<Hit>> {
+pub(super) fn lights_in_front<'t>(lights: &Geometry, texels: impl Iterator<Item = &'t Texel>) -> Vec<Option<Hit>> {
     let (rays, tmax): (Vec<Ray>, Vec<f32>) = texels.map(|texel| (texel.ray, texel.t)).unzip();
     let mut hits = vec![None; rays.len()];
     lights.intersect_each(&rays, &tmax, &mut hits);
@@ -381,24 +351,8 @@ fn own_weights(solution: &Radiosity, p: Vec3, n: Vec3, list: &mut Vec<(u32, f32)
     }
 }
 
-/// The index in [`FirstSample::anchors`] of the anchor at pixel (x, y)
-/// (both even) of an image `w` pixels wide.
-fn anchor_index(x: usize, y: usize, w: usize) -> usize {
-    y / 2 * w.div_ceil(2) + x / 2
-}
-
-/// Whether an anchor's hit at `q` (normal `m`, on the ray's side) may lend
-/// its irradiance to a hit at `p` (normal `n`): nearly the same normal,
-/// nearly the same plane and within half the kernel's radius, so that the
-/// kernel's average changes little and smoothly between them. Across a
-/// silhouette or a crease it fails, and the pixel looks up its own.
-fn same_surface(p: Vec3, n: Vec3, q: Vec3, m: Vec3, radius: f32) -> bool {
-    let d = q - p;
-    n.dot(m) >= 0.99 && n.dot(d).abs() <= 0.02 * radius && d.length_squared() <= (0.5 * radius) * (0.5 * radius)
-}
-
 /// Sample 0's generator of a pixel, as the renderer makes it.
-fn first_sampler(scene: &Scene, pixel: u64) -> Sampler {
+pub(super) fn first_sampler(scene: &Scene, pixel: u64) -> Sampler {
     Sampler::for_pixel(scene.settings().seed, pixel, 0)
 }
 
@@ -408,7 +362,7 @@ fn key(scene: &Scene) -> Key {
 }
 
 /// The surfaces of the scene's area lights where they are now.
-fn light_surfaces(scene: &Scene) -> Geometry {
+pub(super) fn light_surfaces(scene: &Scene) -> Geometry {
     let mut g = GeometryBuilder::default();
     for s in scene.surfaces().filter(|s| s.emitter.is_some()) {
         g.add(&s.shape, s.material, s.emitter);
@@ -464,100 +418,5 @@ mod tests {
     fn in_a_medium_too() {
         let text = format!("{CORNELL}\n[medium]\nsigma_a = 0.01\nsigma_s = 0.03\n");
         check(&mut SceneFile::from_toml_str(&text, None).unwrap().scene);
-    }
-
-    /// The largest error of a pixel relative to its value, the mean error
-    /// relative to the mean value, and the share of pixels that differ, of
-    /// a sparse render against the exact one, whose anchors must be the
-    /// same bits.
-    fn sparse_against_exact(scene: &Scene, sparse: &Image, exact: &Image) -> (f32, f32, f32) {
-        let (w, h) = (scene.settings().width, scene.settings().height);
-        let (mut differ, mut worst, mut total_error, mut total) = (0, 0.0f32, 0.0f32, 0.0f32);
-        for y in 0..h {
-            for x in 0..w {
-                let (a, b) = (sparse.pixel(x, y), exact.pixel(x, y));
-                if x % 2 == 0 && y % 2 == 0 {
-                    assert_eq!(a, b, "anchor ({x}, {y})");
-                }
-                let error = (a - b).abs().max_element();
-                differ += (error > 0.0) as u32;
-                worst = worst.max(error / b.max_element().max(1e-3));
-                (total_error, total) = (total_error + error, total + b.max_element());
-            }
-        }
-        (worst, total_error / total, differ as f32 / (w * h) as f32)
-    }
-
-    /// The sparse fill against the exact one, from a camera in the room
-    /// looking into a corner past the boxes (silhouettes, creases, walls at
-    /// a slant), and from the scene's own camera (the ceiling and floor
-    /// seen at a slant up to the back wall): the anchors' pixels are the
-    /// same bits, every other pixel within a small part of its value, and
-    /// an exact render of the same view refills and gives the exact image
-    /// again. Camera rays through pixel centres: with jitter, the exact
-    /// image's own sub-pixel offsets would be measured too.
-    #[test]
-    fn a_sparse_fill_interpolates_the_indirect_light_closely_and_keeps_the_anchors_exact() {
-        let mut scene = SceneFile::from_toml_str(CORNELL, None).unwrap().scene;
-        scene.settings_mut().filter = PixelFilter::Point;
-        let options = RadiosityOptions::default();
-        let solution = Radiosity::compile(&scene, &options).unwrap();
-        let own = *scene.camera();
-        let corner = Camera::look_at(vec3(2.0, 2.0, -1.0), vec3(5.56, 2.0, 2.0), glam::Vec3::Y, 39.3);
-        // Measured: 3.0% and 0.017% into the corner at 192×108 (76% and
-        // 0.11% if anchors across silhouettes and creases are taken too);
-        // 12.7% and 0.017% from the scene's camera at the viewer's 640×360,
-        // at worst on the ceiling beside the light seen at a slant (10–13%
-        // there) and on the floor at a box's foot, in its shadow (8–13% of
-        // a dark pixel). Anchors behind the light, which lent the shadowed
-        // ceiling behind it, gave 15.0% before they were left out; 37% with
-        // anchors every fourth pixel taken within the whole kernel radius.
-        // That camera sees the room through its open side: the background
-        // around it has no indirect light to blend.
-        let views = [(corner, (192, 108), 0.05, 0.5), (own, (640, 360), 0.14, 0.15)];
-        for (camera, (w, h), worst_allowed, blended) in views {
-            scene.set_camera(camera);
-            (scene.settings_mut().width, scene.settings_mut().height) = (w, h);
-            let preview = Preview::new(&scene, Some(&solution), AnalyticOptions::default(), RaymarchOptions::default());
-            let exact = render_samples(&scene, &preview, 0, 1, &RenderObserver::none());
-            let mut cache = FirstSample::new(&scene);
-            let sparse = cache.render(&scene, Some(&solution), &preview, Fill::Sparse);
-            assert!(cache.is_valid_for(&scene, Fill::Sparse) && !cache.is_valid_for(&scene, Fill::Exact));
-            let (worst, mean, differ) = sparse_against_exact(&scene, &sparse, &exact);
-            assert!(differ > blended, "the pixels between anchors were blended: {differ}");
-            assert!(worst < worst_allowed, "{worst}");
-            assert!(mean < 5e-4, "{mean}");
-            let again = cache.render(&scene, Some(&solution), &preview, Fill::Exact);
-            assert_eq!(again, exact);
-            assert!(cache.is_valid_for(&scene, Fill::Sparse), "an exact fill serves a sparse render too");
-        }
-    }
-
-    /// From the scene's own camera, which sees the light under the
-    /// ceiling, with jittered camera rays: a sparse fill's anchors and
-    /// every pixel of the light are the exact image's bits.
-    #[test]
-    fn a_sparse_fill_sees_the_light_where_the_exact_one_does() {
-        let mut scene = SceneFile::from_toml_str(CORNELL, None).unwrap().scene;
-        (scene.settings_mut().width, scene.settings_mut().height) = (96, 96);
-        let options = RadiosityOptions::default();
-        let solution = Radiosity::compile(&scene, &options).unwrap();
-        let preview = Preview::new(&scene, Some(&solution), AnalyticOptions::default(), RaymarchOptions::default());
-        let exact = render_samples(&scene, &preview, 0, 1, &RenderObserver::none());
-        let sparse = FirstSample::new(&scene).render(&scene, Some(&solution), &preview, Fill::Sparse);
-        let mut light = 0;
-        for y in 0..96 {
-            for x in 0..96 {
-                let (a, b) = (sparse.pixel(x, y), exact.pixel(x, y));
-                // The light's radiance is (34, 24, 8); nothing else is that bright.
-                if b.x > 20.0 {
-                    assert_eq!(a, b, "light ({x}, {y})");
-                    light += 1;
-                } else if x % 2 == 0 && y % 2 == 0 {
-                    assert_eq!(a, b, "anchor ({x}, {y})");
-                }
-            }
-        }
-        assert!(light > 20, "the light covers {light} pixels");
     }
 }

@@ -18,6 +18,7 @@ use crate::sampling::Sampler;
 use crate::scene::Scene;
 
 mod cache;
+mod sparse;
 pub use cache::{Fill, FirstSample};
 
 /// March steps per ray when the medium has no closed form (height fog, a
