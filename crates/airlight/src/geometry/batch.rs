@@ -63,14 +63,16 @@ impl Geometry {
     /// neighbouring rays together. Rays are fastest in the order of nearby
     /// pixels (a tile), whose packets share most of their traversal.
     /// Sixteen rays at a time where the processor has AVX-512, eight where
-    /// it has AVX, else four.
+    /// it has AVX, else four; in a small scene (a room of quads and boxes),
+    /// eight rays against each primitive in turn.
     pub fn intersect_packet(&self, rays: &[Ray], tmax: f32, hits: &mut [Option<Hit>]) {
         self.intersect_packet_on(LaneWidth::widest(), rays, tmax, hits)
     }
 
     /// [`Geometry::intersect_packet`] on the given lanes, which the
     /// processor must have ([`LaneWidth::available`]; panics if not): for
-    /// tests and benchmarks.
+    /// tests and benchmarks. (A small scene's packets take its own lanes,
+    /// whatever is given.)
     #[doc(hidden)]
     pub fn intersect_packet_on(&self, lanes: LaneWidth, rays: &[Ray], tmax: f32, hits: &mut [Option<Hit>]) {
         assert!(lanes.available(), "this processor has no {lanes:?} lanes");
@@ -122,7 +124,8 @@ impl Geometry {
     }
 
     /// [`Geometry::occluded_packet`] on the given lanes, which the processor
-    /// must have (panics if not): for tests and benchmarks.
+    /// must have (panics if not): for tests and benchmarks. (A small scene's
+    /// packets take its own lanes, whatever is given.)
     #[doc(hidden)]
     pub fn occluded_packet_on(&self, lanes: LaneWidth, segments: &[Segment], blocked: &mut [bool]) {
         assert!(lanes.available(), "this processor has no {lanes:?} lanes");

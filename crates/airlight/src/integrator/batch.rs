@@ -69,9 +69,9 @@ impl DeferredShadows {
         super::emitted(scene, ray, surface)
     }
 
-    /// Traces the kept terms' shadow rays in `geometry` and adds each
-    /// visible term (through `medium`, if any, as `surface_radiance` does)
-    /// to its sample's `out[sample]`.
+    /// Traces the kept terms' shadow rays through the scene's geometry and
+    /// adds each visible term (through `medium`, if any, as
+    /// `surface_radiance` does) to its sample's `out[sample]`.
     pub fn resolve(&mut self, scene: &Scene, medium: Option<&Medium>, out: &mut [Rgb]) {
         let DeferredShadows { candidates, order, segments, blocked_sorted, blocked } = self;
         // Shadow rays toward one light after another, each light's in the
