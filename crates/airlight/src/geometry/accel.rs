@@ -438,7 +438,10 @@ impl Geometry {
         let p = ray.at(hit.t);
         let (index, id) = (hit.id as usize, hit.id);
         match self.records.get(index) {
-            Some(rec) => SurfaceHit { p, n: rec.prim.normal(p), material: rec.material, emitter: rec.emitter, id },
+            Some(rec) => {
+                let n = self.small.as_ref().and_then(|s| s.quad_normal(index)).unwrap_or_else(|| rec.prim.normal(p));
+                SurfaceHit { p, n, material: rec.material, emitter: rec.emitter, id }
+            }
             None => match self.planes.get(index - self.records.len()) {
                 Some(plane) => SurfaceHit { p, n: plane.normal, material: plane.material, emitter: None, id },
                 None => {

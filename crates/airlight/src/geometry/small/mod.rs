@@ -40,6 +40,10 @@ pub(super) struct Small {
     quads: QuadLanes,
     boxes: BoxLanes,
     others: Vec<Other>,
+    /// Each record's unit normal if it is a quad (whose normal is the same
+    /// everywhere): the normal of each hit without a square root and a
+    /// division of its own.
+    quad_normals: Vec<Option<Vec3>>,
     /// The instructions the tests run on.
     isa: Isa,
 }
@@ -155,10 +159,20 @@ pub(super) fn small_scene(records: &[Record]) -> Option<Small> {
             others.push(Other { index, center: 0.5 * (min + max), radius_squared: radius * radius });
         }
     }
-    Some(Small { quads: QuadLanes::new(&quads), boxes: BoxLanes::new(&boxes), others, isa: Isa::best() })
+    // `Prim::normal`'s own arithmetic, done once: the same bits.
+    let quad_normals =
+        records.iter().map(|r| matches!(r.prim, Prim::Quad { .. }).then(|| r.prim.normal(Vec3::ZERO))).collect();
+    let (quads, boxes) = (QuadLanes::new(&quads), BoxLanes::new(&boxes));
+    Some(Small { quads, boxes, others, quad_normals, isa: Isa::best() })
 }
 
 impl Small {
+    /// The unit normal of record `index` if it is a quad.
+    #[inline]
+    pub fn quad_normal(&self, index: usize) -> Option<Vec3> {
+        self.quad_normals.get(index).copied().flatten()
+    }
+
     /// Keeps in `best` the nearest hit of the ray `o + t·d`, 0 < t < tmax,
     /// if it comes before `best` (closer, or as close and of a lower index).
     #[inline]
