@@ -10,7 +10,10 @@ use rand::RngExt;
 use rand_pcg::Pcg32;
 use std::f32::consts::PI;
 
-/// A per-pixel stream of uniform numbers in [0, 1).
+/// A per-pixel stream of uniform numbers in [0, 1). A clone goes on with
+/// the same numbers (the viewer keeps a pixel's stream after its camera's
+/// draws, to shade from there frame after frame).
+#[derive(Clone)]
 pub struct Sampler {
     rng: Pcg32,
     /// The sample's number within its pixel, across passes.

@@ -30,8 +30,11 @@ use std::cell::RefCell;
 use std::f32::consts::FRAC_1_PI;
 
 /// One pixel's camera ray and what it meets among the objects.
-#[derive(Clone, Copy)]
+#[derive(Clone)]
 pub(super) struct Texel {
+    /// Sample 0's generator after the camera's draws: where the
+    /// integrator's start.
+    pub sampler: Sampler,
     pub ray: Ray,
     pub hit: Option<SurfaceHit>,
     /// The hit's distance, or how far the preview follows a ray that hits nothing.
@@ -48,9 +51,14 @@ pub(super) struct Texel {
 
 impl Texel {
     /// A texel whose camera ray meets no object (yet).
-    pub fn missed(ray: Ray) -> Texel {
-        let (start, len, scale) = (0, 0, 0.0);
-        Texel { ray, hit: None, t: f32::INFINITY, albedo: Rgb::ZERO, start, len, scale, indirect: Indirect::Own }
+    pub fn missed(sampler: Sampler, ray: Ray) -> Texel {
+        let (start, len, scale, albedo) = (0, 0, 0.0, Rgb::ZERO);
+        Texel { sampler, ray, hit: None, t: f32::INFINITY, albedo, start, len, scale, indirect: Indirect::Own }
+    }
+
+    /// A placeholder, to be overwritten.
+    pub fn empty() -> Texel {
+        Texel::missed(Sampler::for_pixel(0, 0, 0), Ray::new(Vec3::ZERO, Vec3::Z))
     }
 }
 
@@ -156,7 +164,7 @@ impl FirstSample {
         self.key = None;
         let s = scene.settings();
         let (w, h) = (s.width as usize, s.height as usize);
-        self.texels.resize(w * h, Texel::missed(Ray::new(Vec3::ZERO, Vec3::Z)));
+        self.texels.resize(w * h, Texel::empty());
         self.weights.resize_with(h, Vec::new);
         let objects = &self.objects;
         let camera = scene.camera().rays(s.width, s.height);
@@ -197,24 +205,26 @@ pub(super) fn trace_texels(
 ) {
     let s = scene.settings();
     let w = s.width as usize;
-    let Tracing { films, lenses, rays, hits } = scratch;
+    let Tracing { films, lenses, samplers, rays, hits } = scratch;
     // The preview's camera numbers are not stratified: two independent
-    // pairs, which `Rows::shade` skips.
+    // pairs, drawn from the generator the integrator then goes on with.
     films.clear();
     lenses.clear();
+    samplers.clear();
     for x in columns.step_by(step) {
-        let mut sampler = first_sampler(scene, (y * w + x) as u64);
+        let mut sampler = Sampler::for_pixel(s.seed, (y * w + x) as u64, 0);
         let (film, lens) = film_sample(s.filter, false, x as u32, y as u32, &mut sampler);
         films.push(film);
         lenses.push(lens);
+        samplers.push(sampler);
     }
     rays.clear();
     camera.rays_into(films, lenses, rays);
     hits.clear();
     hits.resize(rays.len(), None);
     objects.intersect_packet(rays, f32::INFINITY, hits);
-    for ((texel, &ray), &hit) in out.iter_mut().zip(rays.iter()).zip(hits.iter()) {
-        *texel = Texel::missed(ray);
+    for (((texel, &ray), &hit), sampler) in out.iter_mut().zip(rays.iter()).zip(hits.iter()).zip(samplers.drain(..)) {
+        *texel = Texel::missed(sampler, ray);
         if let Some(hit) = hit {
             let surface = objects.surface(&ray, hit);
             texel.hit = Some(surface);
@@ -229,6 +239,7 @@ pub(super) fn trace_texels(
 pub(super) struct Tracing {
     films: Vec<Vec2>,
     lenses: Vec<Vec2>,
+    samplers: Vec<Sampler>,
     rays: Vec<Ray>,
     hits: Vec<Option<Hit>>,
 }
@@ -273,10 +284,7 @@ impl Rows<'_> {
         samplers.clear();
         shadows.clear();
         for (x, ((texel, light_hit), out)) in texels.iter().zip(&light_hits).zip(row.iter_mut()).enumerate() {
-            let mut sampler = first_sampler(scene, (y * w + x) as u64);
-            // The camera's draws, made by the renderer before the integrator's.
-            sampler.next2();
-            sampler.next2();
+            let mut sampler = texel.sampler.clone();
             let ray = &texel.ray;
             *out = match (light_hit, &texel.hit) {
                 // A light's surface in front of the objects (it reflects nothing).
@@ -349,11 +357,6 @@ fn own_weights(solution: &Radiosity, p: Vec3, n: Vec3, list: &mut Vec<(u32, f32)
         Some(scale) => (start, list.len() as u32 - start, scale),
         None => (start, 0, 0.0),
     }
-}
-
-/// Sample 0's generator of a pixel, as the renderer makes it.
-pub(super) fn first_sampler(scene: &Scene, pixel: u64) -> Sampler {
-    Sampler::for_pixel(scene.settings().seed, pixel, 0)
 }
 
 fn key(scene: &Scene) -> Key {

@@ -56,7 +56,7 @@ impl FirstSample {
         image.pixels.par_chunks_mut(w.max(1)).enumerate().for_each(|(y, row)| {
             with_scratch(&ROWS, |scratch| {
                 let texels = &mut scratch.texels;
-                texels.resize(w, Texel::missed(Ray::new(Vec3::ZERO, Vec3::Z)));
+                texels.resize(w, Texel::empty());
                 trace_texels(scene, objects, &camera, y, 0..w, 1, &mut scratch.tracing, texels);
                 if solution.is_some() {
                     for (x, texel) in texels.iter_mut().enumerate().filter(|(_, t)| t.hit.is_some()) {
@@ -86,7 +86,7 @@ impl FirstSample {
         self.anchors.par_chunks_mut(columns.max(1)).enumerate().for_each(|(j, row)| {
             with_scratch(&ROWS, |scratch| {
                 let texels = &mut scratch.texels;
-                texels.resize(columns, Texel::missed(Ray::new(Vec3::ZERO, Vec3::Z)));
+                texels.resize(columns, Texel::empty());
                 trace_texels(scene, objects, camera, 2 * j, 0..w, 2, &mut scratch.tracing, texels);
                 let behind_light = lights_in_front(lights, texels.iter());
                 for ((anchor, texel), light) in row.iter_mut().zip(texels.iter()).zip(behind_light) {
