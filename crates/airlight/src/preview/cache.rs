@@ -124,9 +124,10 @@ impl FirstSample {
         }
     }
 
-    /// Whether the next [`FirstSample::render`] reuses cached hits (an
-    /// exact fill's, which serve either fill; a sparse render keeps none).
-    pub fn is_valid_for(&self, scene: &Scene, _fill: Fill) -> bool {
+    /// Whether the next [`FirstSample::render`] reuses cached hits, with
+    /// either fill (the cache holds an exact fill's; a sparse render keeps
+    /// none).
+    pub fn is_valid(&self, scene: &Scene) -> bool {
         self.key == Some(key(scene))
     }
 
@@ -139,10 +140,10 @@ impl FirstSample {
     /// row's texels are made, shaded and dropped (a kept exact fill is
     /// used as it is).
     pub fn render(&mut self, scene: &Scene, solution: Option<&Radiosity>, preview: &Preview, fill: Fill) -> Image {
-        if fill == Fill::Sparse && !self.is_valid_for(scene, fill) {
+        if fill == Fill::Sparse && !self.is_valid(scene) {
             return self.render_sparse(scene, solution, preview);
         }
-        if !self.is_valid_for(scene, fill) {
+        if !self.is_valid(scene) {
             self.fill(scene, solution);
         }
         let lights = light_surfaces(scene);
@@ -171,7 +172,7 @@ impl FirstSample {
         self.texels.par_chunks_mut(w.max(1)).zip(self.weights.par_iter_mut()).enumerate().for_each(
             |(y, (texels, weights))| {
                 with_scratch(&ROWS, |scratch| {
-                    trace_texels(scene, objects, &camera, y, 0..w, 1, &mut scratch.tracing, texels);
+                    trace_texels(scene, objects, &camera, y, 0..w, &mut scratch.tracing, texels);
                 });
                 weights.clear();
                 if let Some(solution) = solution {
@@ -188,18 +189,16 @@ impl FirstSample {
     }
 }
 
-/// The texels of row `y` at columns `first, first + step, …` below `w`
-/// (into `out`, one per column): camera rays made together and traced as
-/// a packet, with their hits' surfaces and albedos (lookup weights and
-/// indirect sources are the caller's to set).
-#[allow(clippy::too_many_arguments)]
+/// The texels of row `y` at `columns` (into `out`, one per column): camera
+/// rays made together and traced as a packet, with their hits' surfaces
+/// and albedos (lookup weights and indirect sources are the caller's to
+/// set).
 pub(super) fn trace_texels(
     scene: &Scene,
     objects: &Geometry,
     camera: &CameraRays,
     y: usize,
-    columns: std::ops::Range<usize>,
-    step: usize,
+    columns: impl Iterator<Item = usize>,
     scratch: &mut Tracing,
     out: &mut [Texel],
 ) {
@@ -211,7 +210,7 @@ pub(super) fn trace_texels(
     films.clear();
     lenses.clear();
     samplers.clear();
-    for x in columns.step_by(step) {
+    for x in columns {
         let mut sampler = Sampler::for_pixel(s.seed, (y * w + x) as u64, 0);
         let (film, lens) = film_sample(s.filter, false, x as u32, y as u32, &mut sampler);
         films.push(film);
@@ -397,7 +396,7 @@ mod tests {
             scene.set_lights(&moved);
             solution.update(scene, options.bounces);
             let preview = preview_of(scene, Some(&solution));
-            assert_eq!(cache.is_valid_for(scene, Fill::Exact), k > 0, "the camera stood still");
+            assert_eq!(cache.is_valid(scene), k > 0, "the camera stood still");
             let cached = cache.render(scene, Some(&solution), &preview, Fill::Exact);
             let direct = render_samples(scene, &preview, 0, 1, &RenderObserver::none());
             assert_eq!(cached, direct, "light at {at}");
@@ -406,7 +405,7 @@ mod tests {
         let mut camera = *scene.camera();
         camera.position.x += 0.1;
         scene.set_camera(camera);
-        assert!(!cache.is_valid_for(scene, Fill::Exact));
+        assert!(!cache.is_valid(scene));
         let preview = preview_of(scene, Some(&solution));
         let cached = cache.render(scene, Some(&solution), &preview, Fill::Exact);
         assert_eq!(cached, render_samples(scene, &preview, 0, 1, &RenderObserver::none()));

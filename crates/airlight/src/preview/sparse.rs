@@ -57,7 +57,7 @@ impl FirstSample {
             with_scratch(&ROWS, |scratch| {
                 let texels = &mut scratch.texels;
                 texels.resize(w, Texel::empty());
-                trace_texels(scene, objects, &camera, y, 0..w, 1, &mut scratch.tracing, texels);
+                trace_texels(scene, objects, &camera, y, 0..w, &mut scratch.tracing, texels);
                 if solution.is_some() {
                     for (x, texel) in texels.iter_mut().enumerate().filter(|(_, t)| t.hit.is_some()) {
                         let anchor = x.is_multiple_of(2) && y.is_multiple_of(2);
@@ -87,7 +87,7 @@ impl FirstSample {
             with_scratch(&ROWS, |scratch| {
                 let texels = &mut scratch.texels;
                 texels.resize(columns, Texel::empty());
-                trace_texels(scene, objects, camera, 2 * j, 0..w, 2, &mut scratch.tracing, texels);
+                trace_texels(scene, objects, camera, 2 * j, (0..w).step_by(2), &mut scratch.tracing, texels);
                 let behind_light = lights_in_front(lights, texels.iter());
                 for ((anchor, texel), light) in row.iter_mut().zip(texels.iter()).zip(behind_light) {
                     *anchor = match &texel.hit {
@@ -219,14 +219,14 @@ mod tests {
             let exact = render_samples(&scene, &preview, 0, 1, &RenderObserver::none());
             let mut cache = FirstSample::new(&scene);
             let sparse = cache.render(&scene, Some(&solution), &preview, Fill::Sparse);
-            assert!(!cache.is_valid_for(&scene, Fill::Sparse), "a sparse render keeps no texels");
+            assert!(!cache.is_valid(&scene), "a sparse render keeps no texels");
             let (worst, mean, differ) = sparse_against_exact(&scene, &sparse, &exact);
             assert!(differ > blended, "the pixels between anchors were blended: {differ}");
             assert!(worst < worst_allowed, "{worst}");
             assert!(mean < 5e-4, "{mean}");
             let again = cache.render(&scene, Some(&solution), &preview, Fill::Exact);
             assert_eq!(again, exact);
-            assert!(cache.is_valid_for(&scene, Fill::Sparse), "an exact fill serves a sparse render too");
+            assert!(cache.is_valid(&scene), "an exact fill serves a sparse render too");
         }
     }
 
