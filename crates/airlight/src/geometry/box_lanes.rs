@@ -13,7 +13,7 @@
 //! the distances are the same bit for bit and images do not change.
 
 use super::quad_lanes::any_below;
-use super::small::{RAYS, RayLanes, keep_if_before};
+use super::small::LaneGroup;
 use glam::{Affine3A, Vec3};
 
 /// Boxes per group: one SSE register per operation.
@@ -26,7 +26,7 @@ const LANES: usize = 4;
 /// ray as it is needs no such argument.) Unused lanes have id u32::MAX and
 /// always miss.
 #[derive(Clone, Debug)]
-struct Group {
+pub(super) struct Group {
     /// Columns of the linear part of local_from_world, then its translation.
     axes: [[[f32; LANES]; 3]; 3],
     translation: [[f32; LANES]; 3],
@@ -106,35 +106,9 @@ impl BoxLanes {
         false
     }
 
-    /// Keeps, for each ray r of the packet, its nearest box hit in
-    /// (`best_t[r]`, `best_id[r]`) if it comes before what they hold: the
-    /// boxes one after another, each against all eight rays at once.
-    // One index across the packet's arrays.
-    #[allow(clippy::needless_range_loop)]
-    #[inline(always)]
-    pub fn nearest_in_packet(&self, rays: &RayLanes, best_t: &mut [f32; RAYS], best_id: &mut [u32; RAYS]) {
-        for g in &self.groups {
-            for (k, &id) in g.id.iter().enumerate().filter(|&(_, &id)| id != u32::MAX) {
-                for r in 0..RAYS {
-                    let t = distance(g, k, rays.origin(r), rays.dir(r), rays.tmax[r]);
-                    keep_if_before(t, id, &mut best_t[r], &mut best_id[r]);
-                }
-            }
-        }
-    }
-
-    /// Marks in `blocked` each ray of the packet that a box meets.
-    // One index across the packet's arrays.
-    #[allow(clippy::needless_range_loop)]
-    #[inline(always)]
-    pub fn any_in_packet(&self, rays: &RayLanes, blocked: &mut [bool; RAYS]) {
-        for g in &self.groups {
-            for (k, _) in g.id.iter().enumerate().filter(|&(_, &id)| id != u32::MAX) {
-                for r in 0..RAYS {
-                    blocked[r] |= distance(g, k, rays.origin(r), rays.dir(r), rays.tmax[r]) < rays.tmax[r];
-                }
-            }
-        }
+    /// The groups, for the packet tests (`small/packets.rs`).
+    pub fn groups(&self) -> &[Group] {
+        &self.groups
     }
 }
 
@@ -188,6 +162,18 @@ fn distance(g: &Group, k: usize, o: Vec3, d: Vec3, tmax: f32) -> f32 {
         f32::INFINITY
     };
     if g.id[k] == u32::MAX { f32::INFINITY } else { t }
+}
+
+impl LaneGroup for Group {
+    #[inline(always)]
+    fn ids(&self) -> &[u32] {
+        &self.id
+    }
+
+    #[inline(always)]
+    fn distance(&self, k: usize, o: Vec3, d: Vec3, tmax: f32) -> f32 {
+        distance(self, k, o, d, tmax)
+    }
 }
 
 #[cfg(test)]

@@ -12,7 +12,7 @@
 //! same order, so the hits are the same bit for bit as testing the quads
 //! one by one: images do not change, only the time.
 
-use super::small::{RAYS, RayLanes, keep_if_before};
+use super::small::LaneGroup;
 use glam::Vec3;
 
 /// Quads per group: two SSE registers per operation, enough independent
@@ -22,7 +22,7 @@ const LANES: usize = 8;
 /// Eight quads, each field one array across them. Unused lanes have a zero
 /// normal, which the parallel-ray test rejects.
 #[derive(Clone, Debug)]
-struct Group {
+pub(super) struct Group {
     corner: [[f32; LANES]; 3],
     edge_u: [[f32; LANES]; 3],
     edge_v: [[f32; LANES]; 3],
@@ -102,36 +102,9 @@ impl QuadLanes {
         false
     }
 
-    /// Keeps, for each ray r of the packet, its nearest quad hit in
-    /// (`best_t[r]`, `best_id[r]`) if it comes before what they hold (see
-    /// [`keep_if_before`]): the quads one after another, each against all
-    /// eight rays at once.
-    // One index across the packet's arrays.
-    #[allow(clippy::needless_range_loop)]
-    #[inline(always)]
-    pub fn nearest_in_packet(&self, rays: &RayLanes, best_t: &mut [f32; RAYS], best_id: &mut [u32; RAYS]) {
-        for g in &self.groups {
-            for (k, &id) in g.id.iter().enumerate().filter(|&(_, &id)| id != u32::MAX) {
-                for r in 0..RAYS {
-                    let t = distance(g, k, rays.origin(r), rays.dir(r), rays.tmax[r]);
-                    keep_if_before(t, id, &mut best_t[r], &mut best_id[r]);
-                }
-            }
-        }
-    }
-
-    /// Marks in `blocked` each ray of the packet that a quad meets.
-    // One index across the packet's arrays.
-    #[allow(clippy::needless_range_loop)]
-    #[inline(always)]
-    pub fn any_in_packet(&self, rays: &RayLanes, blocked: &mut [bool; RAYS]) {
-        for g in &self.groups {
-            for (k, _) in g.id.iter().enumerate().filter(|&(_, &id)| id != u32::MAX) {
-                for r in 0..RAYS {
-                    blocked[r] |= distance(g, k, rays.origin(r), rays.dir(r), rays.tmax[r]) < rays.tmax[r];
-                }
-            }
-        }
+    /// The groups, for the packet tests (`small/packets.rs`).
+    pub fn groups(&self) -> &[Group] {
+        &self.groups
     }
 }
 
@@ -188,6 +161,18 @@ fn distance(g: &Group, k: usize, o: Vec3, d: Vec3, tmax: f32) -> f32 {
         & (beta >= 0.0)
         & (beta <= 1.0);
     if hit { t } else { f32::INFINITY }
+}
+
+impl LaneGroup for Group {
+    #[inline(always)]
+    fn ids(&self) -> &[u32] {
+        &self.id
+    }
+
+    #[inline(always)]
+    fn distance(&self, k: usize, o: Vec3, d: Vec3, tmax: f32) -> f32 {
+        distance(self, k, o, d, tmax)
+    }
 }
 
 #[cfg(test)]

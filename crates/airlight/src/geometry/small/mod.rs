@@ -25,7 +25,7 @@ use super::records::{Prim, Record};
 use glam::{Affine3A, Vec3};
 
 mod packets;
-pub(in crate::geometry) use packets::{RAYS, RayLanes, keep_if_before};
+pub(in crate::geometry) use packets::{LaneGroup, RAYS, RayLanes};
 
 /// Up to this many primitives, at least half of them quads and none a
 /// signed distance field, single rays test the quads and boxes in SIMD lanes

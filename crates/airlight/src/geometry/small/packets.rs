@@ -51,10 +51,52 @@ impl RayLanes {
 /// ([`comes_before`](crate::geometry::batch::comes_before)), without
 /// branches (so that a loop over a packet's rays vectorises).
 #[inline(always)]
-pub(in crate::geometry) fn keep_if_before(t: f32, id: u32, best_t: &mut f32, best_id: &mut u32) {
+fn keep_if_before(t: f32, id: u32, best_t: &mut f32, best_id: &mut u32) {
     let before = (t < *best_t) | ((t == *best_t) & (*best_id != u32::MAX) & (id < *best_id));
     *best_t = if before { t } else { *best_t };
     *best_id = if before { id } else { *best_id };
+}
+
+/// A group of primitives side by side in lanes (quads or boxes), as the
+/// packet tests read it.
+pub(in crate::geometry) trait LaneGroup {
+    /// Each lane's record, u32::MAX for an unused lane.
+    fn ids(&self) -> &[u32];
+    /// Lane `k`'s hit distance for the ray `o + t·d` in (0, tmax), or
+    /// infinity: the single-ray test's own arithmetic.
+    fn distance(&self, k: usize, o: Vec3, d: Vec3, tmax: f32) -> f32;
+}
+
+/// Keeps, for each ray r of the packet, its nearest hit among `groups` in
+/// (`best_t[r]`, `best_id[r]`) if it comes before what they hold (see
+/// [`keep_if_before`]): the primitives one after another, each against all
+/// eight rays at once.
+// One index across the packet's arrays.
+#[allow(clippy::needless_range_loop)]
+#[inline(always)]
+fn nearest_in_packet<G: LaneGroup>(groups: &[G], rays: &RayLanes, best_t: &mut [f32; RAYS], best_id: &mut [u32; RAYS]) {
+    for g in groups {
+        for (k, &id) in g.ids().iter().enumerate().filter(|&(_, &id)| id != u32::MAX) {
+            for r in 0..RAYS {
+                let t = g.distance(k, rays.origin(r), rays.dir(r), rays.tmax[r]);
+                keep_if_before(t, id, &mut best_t[r], &mut best_id[r]);
+            }
+        }
+    }
+}
+
+/// Marks in `blocked` each ray of the packet that a primitive of `groups` meets.
+// One index across the packet's arrays.
+#[allow(clippy::needless_range_loop)]
+#[inline(always)]
+fn any_in_packet<G: LaneGroup>(groups: &[G], rays: &RayLanes, blocked: &mut [bool; RAYS]) {
+    for g in groups {
+        for (k, _) in g.ids().iter().enumerate().filter(|&(_, &id)| id != u32::MAX) {
+            for r in 0..RAYS {
+                blocked[r] |= g.distance(k, rays.origin(r), rays.dir(r), rays.tmax[r]) < rays.tmax[r];
+            }
+        }
+    }
 }
 
 impl Small {
@@ -116,8 +158,8 @@ impl Small {
         best_t: &mut [f32; RAYS],
         best_id: &mut [u32; RAYS],
     ) {
-        self.quads.nearest_in_packet(rays, best_t, best_id);
-        self.boxes.nearest_in_packet(rays, best_t, best_id);
+        nearest_in_packet(self.quads.groups(), rays, best_t, best_id);
+        nearest_in_packet(self.boxes.groups(), rays, best_t, best_id);
         for r in 0..RAYS {
             if self.others.is_empty() || rays.tmax[r] <= 0.0 {
                 continue;
@@ -169,8 +211,8 @@ impl Small {
     #[allow(clippy::needless_range_loop)]
     #[inline(always)]
     fn any_packet_here(&self, records: &[Record], rays: &RayLanes, blocked: &mut [bool; RAYS]) {
-        self.quads.any_in_packet(rays, blocked);
-        self.boxes.any_in_packet(rays, blocked);
+        any_in_packet(self.quads.groups(), rays, blocked);
+        any_in_packet(self.boxes.groups(), rays, blocked);
         // Plain loops, no closures: all of it inlines (see `any_here`).
         for r in 0..RAYS {
             if blocked[r] || rays.tmax[r] <= 0.0 {
