@@ -42,8 +42,8 @@ impl FirstSample {
     /// Sample 0 of every pixel with the indirect light interpolated
     /// between anchors (see the module documentation).
     pub(super) fn render_sparse(&mut self, scene: &Scene, solution: Option<&Radiosity>, preview: &Preview) -> Image {
-        // The texels a kept exact fill held are overwritten by no one, but
-        // they are no longer this view's.
+        // A kept exact fill's texels stay allocated for the next one, but
+        // they no longer serve this view.
         self.key = None;
         let lights = light_surfaces(scene);
         let (w, h) = (scene.settings().width as usize, scene.settings().height as usize);
