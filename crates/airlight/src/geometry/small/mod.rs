@@ -217,6 +217,14 @@ impl Small {
         };
         self.quads.for_each_nearest(o, d, tmax, &mut keep);
         self.boxes.for_each_hit(o, d, tmax, &mut keep);
+        self.nearest_other(records, o, d, best);
+    }
+
+    /// Keeps in `best` the nearest hit among the records that are neither
+    /// quads nor boxes, if it comes before `best` (single rays and packets).
+    #[inline(always)]
+    fn nearest_other(&self, records: &[Record], o: Vec3, d: Vec3, best: &mut Hit) {
+        // A plain loop, no closure: all of it inlines (see `any_here`).
         for other in &self.others {
             if !other.may_hit(o, d) {
                 continue;
@@ -227,6 +235,18 @@ impl Small {
                 *best = Hit { t, id: i };
             }
         }
+    }
+
+    /// Whether a record that is neither a quad nor a box meets the ray at
+    /// 0 < t < tmax (single rays and packets).
+    #[inline(always)]
+    fn any_other(&self, records: &[Record], o: Vec3, d: Vec3, tmax: f32) -> bool {
+        for other in &self.others {
+            if other.may_hit(o, d) && records[other.index as usize].prim.intersect(o, d, 0.0, tmax) < tmax {
+                return true;
+            }
+        }
+        false
     }
 
     /// Whether anything meets the ray `o + t·d` at 0 < t < tmax.
@@ -262,15 +282,7 @@ impl Small {
     /// [`Small::any`] for whatever instructions its caller is compiled for.
     #[inline(always)]
     fn any_here(&self, records: &[Record], o: Vec3, d: Vec3, tmax: f32) -> bool {
-        if self.quads.any_hit(o, d, tmax) || self.boxes.any_hit(o, d, tmax) {
-            return true;
-        }
-        for other in &self.others {
-            if other.may_hit(o, d) && records[other.index as usize].prim.intersect(o, d, 0.0, tmax) < tmax {
-                return true;
-            }
-        }
-        false
+        self.quads.any_hit(o, d, tmax) || self.boxes.any_hit(o, d, tmax) || self.any_other(records, o, d, tmax)
     }
 }
 

@@ -7,7 +7,7 @@
 //! `distance`), so the hits are the same bit for bit.
 
 use super::{Isa, Small};
-use crate::geometry::batch::test_bound;
+use crate::geometry::Hit;
 use crate::geometry::records::Record;
 use glam::Vec3;
 
@@ -161,18 +161,12 @@ impl Small {
         nearest_in_packet(self.quads.groups(), rays, best_t, best_id);
         nearest_in_packet(self.boxes.groups(), rays, best_t, best_id);
         for r in 0..RAYS {
-            if self.others.is_empty() || rays.tmax[r] <= 0.0 {
+            if rays.tmax[r] <= 0.0 {
                 continue;
             }
-            let (o, d) = (rays.origin(r), rays.dir(r));
-            for other in &self.others {
-                if !other.may_hit(o, d) {
-                    continue;
-                }
-                let i = other.index;
-                let t = records[i as usize].prim.intersect(o, d, 0.0, test_bound(best_t[r], best_id[r]));
-                keep_if_before(t, i, &mut best_t[r], &mut best_id[r]);
-            }
+            let mut best = Hit { t: best_t[r], id: best_id[r] };
+            self.nearest_other(records, rays.origin(r), rays.dir(r), &mut best);
+            (best_t[r], best_id[r]) = (best.t, best.id);
         }
     }
 
@@ -213,17 +207,9 @@ impl Small {
     fn any_packet_here(&self, records: &[Record], rays: &RayLanes, blocked: &mut [bool; RAYS]) {
         any_in_packet(self.quads.groups(), rays, blocked);
         any_in_packet(self.boxes.groups(), rays, blocked);
-        // Plain loops, no closures: all of it inlines (see `any_here`).
         for r in 0..RAYS {
-            if blocked[r] || rays.tmax[r] <= 0.0 {
-                continue;
-            }
-            let (o, d, tmax) = (rays.origin(r), rays.dir(r), rays.tmax[r]);
-            for other in &self.others {
-                if other.may_hit(o, d) && records[other.index as usize].prim.intersect(o, d, 0.0, tmax) < tmax {
-                    blocked[r] = true;
-                    break;
-                }
+            if !blocked[r] && rays.tmax[r] > 0.0 {
+                blocked[r] = self.any_other(records, rays.origin(r), rays.dir(r), rays.tmax[r]);
             }
         }
     }
