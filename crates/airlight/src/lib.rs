@@ -33,6 +33,7 @@ pub mod camera;
 pub mod film;
 pub mod geometry;
 pub mod integrator;
+mod isa;
 pub mod light;
 pub mod material;
 pub mod medium;

@@ -4,14 +4,14 @@
 //! through the BVH, whose bookkeeping costs more there than the tests it
 //! spares.
 //!
-//! The tests are compiled three times, for x86-64's baseline, for AVX2 with
-//! FMA, and for AVX-512 (its 256-bit forms and 32 registers), and the
-//! processor's best is chosen when the scene is built. The arithmetic is
-//! the same in each (Rust never fuses a multiply and an add on its own), so
-//! the hits are the same bit for bit. On an Intel Xeon with AVX-512 the
-//! Cornell box's path tracing took 0.94× the baseline's time on AVX2 and
-//! 0.91× on AVX-512, the viewer's flight 0.90× and 0.86× (6 side-by-side
-//! pairs each). Everything the tests do must inline into each copy: the
+//! The tests are compiled three times (`crate::isa`), for x86-64's
+//! baseline, for AVX2 with FMA, and for AVX-512 (its 256-bit forms and 32
+//! registers), and the processor's best is chosen when the scene is built.
+//! The arithmetic is the same in each (Rust never fuses a multiply and an
+//! add on its own), so the hits are the same bit for bit. On an Intel Xeon
+//! with AVX-512 the Cornell box's path tracing took 0.94× the baseline's
+//! time on AVX2 and 0.91× on AVX-512, the viewer's flight 0.90× and 0.86×
+//! (6 side-by-side pairs each). Everything the tests do must inline into each copy: the
 //! shadow test's `Iterator::any` with a closure was compiled apart, for the
 //! baseline, and cost 1.06×, so the loops here and in the lanes are plain
 //! `for` loops. (The quads' lanes alone compiled for AVX gave no gain on an
@@ -22,6 +22,7 @@ use super::batch::{comes_before, test_bound};
 use super::box_lanes::BoxLanes;
 use super::quad_lanes::QuadLanes;
 use super::records::{Prim, Record};
+use crate::isa::Isa;
 use glam::{Affine3A, Vec3};
 
 mod packets;
@@ -46,53 +47,6 @@ pub(super) struct Small {
     quad_normals: Vec<Option<Vec3>>,
     /// The instructions the tests run on.
     isa: Isa,
-}
-
-/// The instruction sets the small scene's tests are compiled for.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-#[cfg_attr(not(target_arch = "x86_64"), allow(dead_code))]
-enum Isa {
-    Baseline,
-    /// AVX2 and FMA.
-    Avx2,
-    /// AVX-512 F, VL, DQ and BW, with AVX2 and FMA.
-    Avx512,
-}
-
-impl Isa {
-    /// The best this processor has.
-    fn best() -> Isa {
-        #[cfg(target_arch = "x86_64")]
-        {
-            use std::arch::is_x86_feature_detected as has;
-            if has!("avx2") && has!("fma") {
-                if has!("avx512f") && has!("avx512vl") && has!("avx512dq") && has!("avx512bw") {
-                    return Isa::Avx512;
-                }
-                return Isa::Avx2;
-            }
-        }
-        Isa::Baseline
-    }
-}
-
-#[cfg(test)]
-impl Isa {
-    /// Every instruction set this processor runs.
-    fn available() -> Vec<Isa> {
-        let mut isas = vec![Isa::Baseline];
-        #[cfg(target_arch = "x86_64")]
-        {
-            use std::arch::is_x86_feature_detected as has;
-            if has!("avx2") && has!("fma") {
-                isas.push(Isa::Avx2);
-            }
-        }
-        if Isa::best() == Isa::Avx512 {
-            isas.push(Isa::Avx512);
-        }
-        isas
-    }
 }
 
 /// A small scene's record that is neither a quad nor a box, with a sphere
