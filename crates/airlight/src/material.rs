@@ -70,6 +70,17 @@ impl Material {
         }
     }
 
+    /// The BRDF where it does not depend on the directions (every material
+    /// but Phong): what [`Material::brdf`] gives at `p` for any `wo` and
+    /// `wi` on one side of the surface, to the bit. None for Phong.
+    #[inline]
+    pub fn lambertian_brdf(&self, p: Vec3, n: Vec3) -> Option<Rgb> {
+        match self {
+            Material::Phong { .. } => None,
+            _ => Some(self.albedo(p, n) / PI),
+        }
+    }
+
     /// The BRDF for outgoing `wo` and incident `wi` (both pointing away from
     /// the surface) at `p`, with geometric normal `n` facing either way. Zero
     /// when they lie on opposite sides: surfaces reflect on both sides but

@@ -4,28 +4,14 @@
 //! each sample's light summed in the order [`super::surface_radiance`] sums it, so
 //! that each sample's radiance is the one-ray answer, bit for bit.
 
+use super::light_lanes::{Candidate, LaneScratch, LitPoint, light_terms};
 use crate::Rgb;
-use crate::geometry::{Hit, Ray, Segment, SurfaceHit, offset_origin};
+use crate::geometry::{Hit, Ray, Segment, SurfaceHit};
 use crate::medium::Medium;
 use crate::sampling::Sampler;
 use crate::scene::Scene;
 use crate::scratch::with_scratch;
-use glam::Vec3;
 use std::cell::RefCell;
-
-/// A light's contribution to one sample, counted if its shadow ray is clear.
-struct Candidate {
-    sample: usize,
-    light: usize,
-    contribution: Rgb,
-    /// None: no shadow ray is traced and the light counts as hidden.
-    segment: Option<Segment>,
-    /// The shadow ray's lifted origin, direction and the light's distance
-    /// (for a medium's transmittance).
-    origin: Vec3,
-    wi: Vec3,
-    distance: f32,
-}
 
 /// Direct light whose shadow rays are put off: the light terms of many
 /// shading points are kept, then their shadow rays traced as packets
@@ -35,6 +21,8 @@ struct Candidate {
 /// answer, bit for bit.
 #[derive(Default)]
 pub(crate) struct DeferredShadows {
+    points: Vec<LitPoint>,
+    lanes: LaneScratch,
     candidates: Vec<Candidate>,
     order: Vec<usize>,
     segments: Vec<Segment>,
@@ -43,15 +31,15 @@ pub(crate) struct DeferredShadows {
 }
 
 impl DeferredShadows {
-    /// Forgets the kept terms.
+    /// Forgets the kept points.
     pub fn clear(&mut self) {
-        self.candidates.clear();
+        self.points.clear();
     }
 
     /// What [`super::surface_radiance`] gives at `surface` before its light
-    /// terms (the surface's emission); the terms are kept as sample
-    /// `sample`'s, for [`DeferredShadows::resolve`] to add. Draws from
-    /// `sampler` as `surface_radiance` does.
+    /// terms (the surface's emission); the point is kept as sample
+    /// `sample`'s, for [`DeferredShadows::resolve`] to add its terms. Draws
+    /// from `sampler` as `surface_radiance` does.
     pub fn surface(
         &mut self,
         scene: &Scene,
@@ -60,20 +48,20 @@ impl DeferredShadows {
         sampler: &mut Sampler,
         sample: usize,
     ) -> Rgb {
-        super::for_each_light_term(scene, ray, surface, sampler, |light, s, contribution| {
-            let origin = offset_origin(surface.p, surface.n, s.wi);
-            let segment = scene.light_segment(surface.p, origin, s.wi, s.distance);
-            let (wi, distance) = (s.wi, s.distance);
-            self.candidates.push(Candidate { sample, light, contribution, segment, origin, wi, distance });
-        });
+        // `for_each_light_term`'s one draw.
+        let key = sampler.next_key();
+        self.points.push(LitPoint { sample, surface: *surface, wo: -ray.dir, key });
         super::emitted(scene, ray, surface)
     }
 
-    /// Traces the kept terms' shadow rays through the scene's geometry and
-    /// adds each visible term (through `medium`, if any, as
-    /// `surface_radiance` does) to its sample's `out[sample]`.
+    /// Finds the kept points' light terms (many at once: `light_lanes.rs`),
+    /// traces their shadow rays through the scene's geometry and adds each
+    /// visible term (through `medium`, if any, as `surface_radiance` does)
+    /// to its sample's `out[sample]`.
     pub fn resolve(&mut self, scene: &Scene, medium: Option<&Medium>, out: &mut [Rgb]) {
-        let DeferredShadows { candidates, order, segments, blocked_sorted, blocked } = self;
+        let DeferredShadows { points, lanes, candidates, order, segments, blocked_sorted, blocked } = self;
+        candidates.clear();
+        light_terms(scene, points, lanes, candidates);
         // Shadow rays toward one light after another, each light's in the
         // samples' order (neighbouring pixels).
         order.clear();
@@ -89,7 +77,8 @@ impl DeferredShadows {
         for (&c, &b) in order.iter().zip(blocked_sorted.iter()) {
             blocked[c] = b;
         }
-        // Each sample's lights in index order, as `surface_radiance` adds them.
+        // Each sample's lights in index order, as `surface_radiance` adds
+        // them (the candidates hold them so, lights of other samples between).
         for (c, candidate) in candidates.iter().enumerate() {
             if blocked[c] {
                 continue;

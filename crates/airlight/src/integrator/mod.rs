@@ -7,6 +7,7 @@ pub mod analytic;
 mod batch;
 mod direct;
 pub mod equiangular;
+mod light_lanes;
 mod options;
 pub mod path;
 mod radiosity;
@@ -29,6 +30,8 @@ pub use stochastic::{Sampling, Stochastic};
 
 use crate::Rgb;
 use crate::geometry::{Ray, SurfaceHit};
+use crate::light::LightSample;
+use crate::material::Material;
 use crate::medium::Medium;
 use crate::sampling::{Sampler, keyed2};
 use crate::scene::Scene;
@@ -301,22 +304,40 @@ pub(crate) fn for_each_light_term(
     ray: &Ray,
     surface: &SurfaceHit,
     sampler: &mut Sampler,
-    mut term: impl FnMut(usize, &crate::light::LightSample, Rgb),
+    mut term: impl FnMut(usize, &LightSample, Rgb),
 ) {
     let wo = -ray.dir;
     let material = scene.material_at(surface);
     let key = sampler.next_key();
     scene.for_each_emitter_at(surface.p, |index, _| {
-        let u = keyed2(key, index as u64);
-        let Some(sample) = scene.sample_emitter(index, surface.p, u) else { return };
-        let cos = sample.wi.dot(surface.n).abs();
-        if cos == 0.0 {
-            return;
+        if let Some((sample, contribution)) = light_term(scene, index, surface, wo, &material, key) {
+            term(index, &sample, contribution);
         }
-        let f = material.brdf(surface.p, surface.n, wo, sample.wi);
-        if f == Rgb::ZERO {
-            return;
-        }
-        term(index, &sample, f * sample.weight * cos);
     });
+}
+
+/// One term of [`for_each_light_term`]: the sample of emitter `index` drawn
+/// with `key` at `surface` (whose material is `material`), seen along `wo`,
+/// and its contribution f · weight · |cos|; None where it adds nothing.
+#[inline]
+pub(crate) fn light_term(
+    scene: &Scene,
+    index: usize,
+    surface: &SurfaceHit,
+    wo: glam::Vec3,
+    material: &Material,
+    key: u64,
+) -> Option<(LightSample, Rgb)> {
+    let u = keyed2(key, index as u64);
+    let sample = scene.sample_emitter(index, surface.p, u)?;
+    let cos = sample.wi.dot(surface.n).abs();
+    if cos == 0.0 {
+        return None;
+    }
+    let f = material.brdf(surface.p, surface.n, wo, sample.wi);
+    if f == Rgb::ZERO {
+        return None;
+    }
+    let contribution = f * sample.weight * cos;
+    Some((sample, contribution))
 }

@@ -66,6 +66,12 @@ impl Emitters {
         &self.firsts
     }
 
+    /// Whether the emitter that starts at `first` is that light alone:
+    /// [`Emitters::draw`] then returns it, chance 1 and `u` as they are.
+    pub fn is_alone(&self, first: usize) -> bool {
+        self.end_of[first] as usize - first == 1
+    }
+
     /// The chance of drawing light `index` within its emitter: the step of
     /// the cumulative table at it, so that it is exactly the measure of
     /// the numbers that [`Emitters::draw`] maps to it.
@@ -85,10 +91,10 @@ impl Emitters {
     /// returns it with its chance and `u` with `u.x` stretched back over
     /// [0, 1) within the light's share (so stratified numbers stay so).
     pub fn draw(&self, first: usize, u: Vec2) -> (usize, f32, Vec2) {
-        let end = self.end_of[first] as usize;
-        if end - first == 1 {
+        if self.is_alone(first) {
             return (first, 1.0, u);
         }
+        let end = self.end_of[first] as usize;
         let table = &self.cumulative[first..end];
         // The first light whose cumulative chance exceeds u.x.
         let k = table.partition_point(|&c| c <= u.x).min(table.len() - 1);

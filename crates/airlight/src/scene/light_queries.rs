@@ -65,13 +65,11 @@ impl Scene {
     /// ([`Geometry::occluded_packet`](crate::geometry::Geometry::occluded_packet)).
     #[inline]
     pub fn light_segment(&self, p: Vec3, origin: Vec3, wi: Vec3, distance: f32) -> Option<Segment> {
-        const SHORT: f32 = 1.0 - 1e-4;
         if !distance.is_finite() {
-            return Some(Segment { origin, dir: wi, tmax: 2.0 * self.bounds_radius * SHORT });
+            return Some(Segment { origin, dir: wi, tmax: 2.0 * self.bounds_radius * SHADOW_SHORT });
         }
-        let to = p + wi * distance - origin;
-        let length = to.length();
-        (length > 0.0).then(|| Segment { origin, dir: to / length, tmax: length * SHORT })
+        let (dir, tmax) = toward_sample(p, origin, wi, distance);
+        (tmax > 0.0).then_some(Segment { origin, dir, tmax })
     }
 
     /// Calls `f(index, light)` for every emitter that may reach `p`, in
@@ -82,7 +80,7 @@ impl Scene {
     /// than one per triangle. With culling, lights whose range ends before
     /// `p` are skipped without being looked at.
     pub fn for_each_emitter_at(&self, p: Vec3, mut f: impl FnMut(usize, &Light)) {
-        if !self.settings.cull_lights || !self.light_culling.has_ranges() {
+        if !self.culls_lights() {
             for &i in self.emitters.firsts() {
                 f(i as usize, &self.lights[i as usize]);
             }
@@ -100,6 +98,18 @@ impl Scene {
         };
         // A reused buffer, or a fresh one if a caller nests these loops.
         crate::scratch::with_scratch(&FOUND, visit);
+    }
+
+    /// Whether [`Scene::for_each_emitter_at`] skips lights out of range;
+    /// without, it visits [`Scene::emitter_firsts`] at every point.
+    pub fn culls_lights(&self) -> bool {
+        self.settings.cull_lights && self.light_culling.has_ranges()
+    }
+
+    /// Whether the emitter that starts at light `first` is that light
+    /// alone (not an emitting mesh's triangles).
+    pub fn emitter_is_alone(&self, first: usize) -> bool {
+        self.emitters.is_alone(first)
     }
 
     /// The emitters' first lights, in index order: each light, but of a
@@ -135,4 +145,18 @@ impl Scene {
     pub fn emitter_chance(&self, index: usize) -> f32 {
         self.emitters.chance(index)
     }
+}
+
+/// How much of the way to a light sample a shadow ray spans.
+const SHADOW_SHORT: f32 = 1.0 - 1e-4;
+
+/// The direction and span of the shadow ray from `origin` to the light
+/// sample at `p + wi·distance` (finite), stopping just short of it; a
+/// span of 0 (or NaN) where there is no way to go. Without branches, for
+/// callers that find many at once in lanes (`integrator/light_lanes.rs`).
+#[inline(always)]
+pub(crate) fn toward_sample(p: Vec3, origin: Vec3, wi: Vec3, distance: f32) -> (Vec3, f32) {
+    let to = p + wi * distance - origin;
+    let length = to.length();
+    (to / length, length * SHADOW_SHORT)
 }

@@ -19,6 +19,7 @@ mod emitters;
 mod error;
 mod gltf;
 mod light_queries;
+pub(crate) use light_queries::toward_sample;
 mod lights;
 pub mod limits;
 mod mesh;
