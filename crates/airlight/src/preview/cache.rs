@@ -13,7 +13,7 @@
 //! anchors and keeps no texels (`sparse.rs`).
 
 use super::Preview;
-use super::sparse::{Anchor, anchor_index, between_anchors};
+use super::sparse::{Anchor, between_anchors};
 use crate::Rgb;
 use crate::film::Image;
 use crate::geometry::{Geometry, GeometryBuilder, Hit, Ray, SurfaceHit};
@@ -63,13 +63,13 @@ impl Texel {
 }
 
 /// Where a texel's indirect irradiance comes from.
-#[derive(Clone, Copy, PartialEq, Eq)]
+#[derive(Clone, Copy)]
 pub(super) enum Indirect {
     /// Its own lookup's weights.
     Own,
-    /// A sparse render's anchor: its irradiance is looked up once per
-    /// frame, before the rows are shaded (`sparse.rs`).
-    Anchor,
+    /// Known already: a sparse render's anchor's, looked up in the
+    /// anchors' pass (`sparse.rs`); None where no patch is near.
+    Given(Option<Rgb>),
     /// A sparse render's texel between anchors: the mean of its anchors'
     /// irradiance (left and right on an anchor row; above and below on an
     /// anchor column; the four diagonal ones elsewhere) when all of them
@@ -152,8 +152,10 @@ impl FirstSample {
         image.pixels.par_chunks_mut(w.max(1) as usize).enumerate().for_each(|(y, row)| {
             let texels = &self.texels[y * row.len()..(y + 1) * row.len()];
             with_scratch(&ROWS, |scratch| {
-                let rows = Rows { scene, solution, preview, lights: &lights, anchors: &[] };
-                rows.shade(y, texels, &self.weights[y], row, &mut scratch.shading)
+                let RowScratch { shading, light_hits, .. } = scratch;
+                light_hits.find(&lights, texels);
+                let rows = Rows { scene, solution, preview, lights: &lights, weights: &self.weights[y], anchors: &[] };
+                rows.shade(Span::whole(y), texels, &light_hits.hits, row, shading)
             });
         });
         image
@@ -172,7 +174,7 @@ impl FirstSample {
         self.texels.par_chunks_mut(w.max(1)).zip(self.weights.par_iter_mut()).enumerate().for_each(
             |(y, (texels, weights))| {
                 with_scratch(&ROWS, |scratch| {
-                    trace_texels(scene, objects, &camera, y, 0..w, &mut scratch.tracing, texels);
+                    trace_texels(scene, objects, &camera, Span::whole(y), &mut scratch.tracing, texels);
                 });
                 weights.clear();
                 if let Some(solution) = solution {
@@ -189,28 +191,47 @@ impl FirstSample {
     }
 }
 
-/// The texels of row `y` at `columns` (into `out`, one per column): camera
-/// rays made together and traced as a packet, with their hits' surfaces
-/// and albedos (lookup weights and indirect sources are the caller's to
-/// set).
+/// Which pixels of an image row a row of texels is: texel i is pixel
+/// (`first` + i·`step`, `y`).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Span {
+    pub y: usize,
+    pub first: usize,
+    pub step: usize,
+}
+
+impl Span {
+    /// Every pixel of row `y`.
+    pub fn whole(y: usize) -> Span {
+        Span { y, first: 0, step: 1 }
+    }
+
+    /// The span's columns in an image `w` pixels wide.
+    pub fn columns(self, w: usize) -> std::iter::StepBy<std::ops::Range<usize>> {
+        (self.first.min(w)..w).step_by(self.step)
+    }
+}
+
+/// The texels of `span` (into `out`, one per column): camera rays made
+/// together and traced as a packet, with their hits' surfaces and albedos
+/// (lookup weights and indirect sources are the caller's to set).
 pub(super) fn trace_texels(
     scene: &Scene,
     objects: &Geometry,
     camera: &CameraRays,
-    y: usize,
-    columns: impl Iterator<Item = usize>,
+    span: Span,
     scratch: &mut Tracing,
     out: &mut [Texel],
 ) {
     let s = scene.settings();
-    let w = s.width as usize;
+    let (w, y) = (s.width as usize, span.y);
     let Tracing { films, lenses, samplers, rays, hits } = scratch;
     // The preview's camera numbers are not stratified: two independent
     // pairs, drawn from the generator the integrator then goes on with.
     films.clear();
     lenses.clear();
     samplers.clear();
-    for x in columns {
+    for x in span.columns(w) {
         let mut sampler = Sampler::for_pixel(s.seed, (y * w + x) as u64, 0);
         let (film, lens) = film_sample(s.filter, false, x as u32, y as u32, &mut sampler);
         films.push(film);
@@ -247,6 +268,7 @@ pub(super) struct Tracing {
 #[derive(Default)]
 pub(super) struct RowScratch {
     pub tracing: Tracing,
+    pub light_hits: LightHits,
     pub shading: Shading,
     /// A sparse render's row of texels.
     pub texels: Vec<Texel>,
@@ -257,52 +279,62 @@ thread_local! {
 }
 
 /// What shading a row reads: the scene, its radiosity solution, the
-/// preview, the lights' surfaces where they are now, and a sparse frame's
-/// anchors (none for an exact fill).
+/// preview, the lights' surfaces where they are now, an exact fill's
+/// lookup weights for the row (which its texels index) and a sparse
+/// frame's anchors (none for an exact fill).
 pub(super) struct Rows<'a> {
     pub scene: &'a Scene,
     pub solution: Option<&'a Radiosity>,
     pub preview: &'a Preview<'a>,
     pub lights: &'a Geometry,
+    pub weights: &'a [(u32, f32)],
     pub anchors: &'a [Anchor],
 }
 
 impl Rows<'_> {
-    /// What `preview.radiance` gives for row `y`'s sample 0, into `row`,
-    /// from the row's `texels` (and the lookup `weights` they index): the
-    /// camera rays tested against the lights' surfaces together, each
-    /// pixel's light terms gathered and their shadow rays traced together,
-    /// then each pixel finished (indirect light, medium) with its own
-    /// sampler, which draws what the integrator's would.
-    pub fn shade(&self, y: usize, texels: &[Texel], weights: &[(u32, f32)], row: &mut [Rgb], scratch: &mut Shading) {
-        let Rows { scene, solution, preview, lights, anchors } = *self;
-        let w = row.len();
-        let h = scene.settings().height as usize;
-        let Shading { samplers, shadows } = scratch;
-        let light_hits = lights_in_front(lights, texels.iter());
+    /// What `preview.radiance` gives for the sample 0 of `span`'s pixels,
+    /// into their places in the image's `row`, from their `texels` and
+    /// where their camera rays meet the lights' surfaces before the
+    /// objects (`light_hits`, [`LightHits`]): each pixel's light terms
+    /// gathered and their shadow rays traced together, then each pixel
+    /// finished (indirect light, medium) with its own sampler, which draws
+    /// what the integrator's would.
+    pub fn shade(
+        &self,
+        span: Span,
+        texels: &[Texel],
+        light_hits: &[Option<Hit>],
+        row: &mut [Rgb],
+        scratch: &mut Shading,
+    ) {
+        let Rows { scene, solution, preview, lights, weights, anchors } = *self;
+        let (w, h, y) = (row.len(), scene.settings().height as usize, span.y);
+        let Shading { samplers, shadows, radiance } = scratch;
         samplers.clear();
         shadows.clear();
-        for (x, ((texel, light_hit), out)) in texels.iter().zip(&light_hits).zip(row.iter_mut()).enumerate() {
+        radiance.clear();
+        for (k, (texel, light_hit)) in texels.iter().zip(light_hits).enumerate() {
             let mut sampler = texel.sampler.clone();
             let ray = &texel.ray;
-            *out = match (light_hit, &texel.hit) {
+            radiance.push(match (light_hit, &texel.hit) {
                 // A light's surface in front of the objects (it reflects nothing).
-                (Some(hit), _) => shadows.surface(scene, ray, &lights.surface(ray, *hit), &mut sampler, x),
-                (None, Some(s)) => shadows.surface(scene, ray, s, &mut sampler, x),
+                (Some(hit), _) => shadows.surface(scene, ray, &lights.surface(ray, *hit), &mut sampler, k),
+                (None, Some(s)) => shadows.surface(scene, ray, s, &mut sampler, k),
                 (None, None) => scene.settings().background,
-            };
+            });
             samplers.push(sampler);
         }
-        shadows.resolve(scene, scene.medium(), row);
-        for (x, ((texel, light_hit), out)) in texels.iter().zip(&light_hits).zip(row.iter_mut()).enumerate() {
+        shadows.resolve(scene, scene.medium(), radiance);
+        for (k, (x, (texel, light_hit))) in span.columns(w).zip(texels.iter().zip(light_hits)).enumerate() {
             let ray = &texel.ray;
+            let out = &mut radiance[k];
             let t_end = match (light_hit, &texel.hit) {
                 (Some(hit), _) => hit.t,
                 (None, Some(s)) => {
                     if let Some(solution) = solution {
                         let e = match texel.indirect {
                             Indirect::Own => own_irradiance(texel, weights, solution.indirect_irradiance()),
-                            Indirect::Anchor => anchors[anchor_index(x, y, w)].e,
+                            Indirect::Given(e) => e,
                             Indirect::Anchors => between_anchors(anchors, solution, s, ray, (x, y), (w, h)),
                         };
                         if let Some(e) = e {
@@ -313,10 +345,10 @@ impl Rows<'_> {
                 }
                 (None, None) => scene.settings().max_distance,
             };
-            let l = through_medium(scene, ray, *out, t_end, &mut samplers[x], |medium, length, sampler| {
+            let l = through_medium(scene, ray, *out, t_end, &mut samplers[k], |medium, length, sampler| {
                 preview.glow(scene, medium, ray, length, sampler)
             });
-            *out = if l.is_finite() { l } else { Rgb::ZERO };
+            row[x] = if l.is_finite() { l } else { Rgb::ZERO };
         }
     }
 }
@@ -327,15 +359,35 @@ pub(super) struct Shading {
     /// Each pixel's generator, between its light terms and its medium.
     samplers: Vec<Sampler>,
     shadows: DeferredShadows,
+    /// Each texel's radiance so far.
+    radiance: Vec<Rgb>,
 }
 
-/// Where each texel's camera ray meets the lights' surfaces before its
-/// object, traced together.
-pub(super) fn lights_in_front<'t>(lights: &Geometry, texels: impl Iterator<Item = &'t Texel>) -> Vec<Option<Hit>> {
-    let (rays, tmax): (Vec<Ray>, Vec<f32>) = texels.map(|texel| (texel.ray, texel.t)).unzip();
-    let mut hits = vec![None; rays.len()];
-    lights.intersect_each(&rays, &tmax, &mut hits);
-    hits
+/// Where a row's camera rays meet the lights' surfaces before their
+/// objects, traced together.
+#[derive(Default)]
+pub(super) struct LightHits {
+    rays: Vec<Ray>,
+    tmax: Vec<f32>,
+    /// Per texel, its camera ray's hit on a light's surface in front of
+    /// its object.
+    pub hits: Vec<Option<Hit>>,
+}
+
+impl LightHits {
+    /// Finds the hits of `texels`' camera rays.
+    pub fn find(&mut self, lights: &Geometry, texels: &[Texel]) {
+        let LightHits { rays, tmax, hits } = self;
+        rays.clear();
+        tmax.clear();
+        for texel in texels {
+            rays.push(texel.ray);
+            tmax.push(texel.t);
+        }
+        hits.clear();
+        hits.resize(rays.len(), None);
+        lights.intersect_each(rays, tmax, hits);
+    }
 }
 
 /// A texel's irradiance from its own lookup weights (in its row's `list`),

@@ -9,13 +9,14 @@
 //! The viewer renders so while the camera moves and goes back to
 //! [`Fill::Exact`] when it stops.
 //!
-//! Such a frame's texels serve it alone, so none are kept: the anchors are
-//! traced first, then each row's texels are made, shaded and dropped in a
-//! buffer of the thread's (a kept frame of texels, 100 bytes a pixel, was
-//! written and read back through memory every frame).
+//! Such a frame's texels serve it alone, so none are kept: the anchors'
+//! pixels are traced, looked up and shaded first, then each row's other
+//! texels are made, shaded and dropped in a buffer of the thread's (a kept
+//! frame of texels, 100 bytes a pixel, was written and read back through
+//! memory every frame).
 
 use super::Preview;
-use super::cache::{FirstSample, Indirect, ROWS, Rows, Texel, light_surfaces, lights_in_front, trace_texels};
+use super::cache::{FirstSample, Indirect, ROWS, RowScratch, Rows, Span, Texel, light_surfaces, trace_texels};
 use crate::film::Image;
 use crate::geometry::{Geometry, Ray, SurfaceHit};
 use crate::radiosity::Radiosity;
@@ -48,48 +49,62 @@ impl FirstSample {
         let lights = light_surfaces(scene);
         let (w, h) = (scene.settings().width as usize, scene.settings().height as usize);
         let camera = scene.camera().rays(w as u32, h as u32);
-        if let Some(solution) = solution {
-            self.trace_anchors(scene, solution, &lights, &camera);
-        }
         let mut image = Image::new(w as u32, h as u32);
+        if let Some(solution) = solution {
+            self.shade_anchors(scene, solution, preview, &lights, &camera, &mut image);
+        }
         let (objects, anchors) = (&self.objects, &self.anchors);
         image.pixels.par_chunks_mut(w.max(1)).enumerate().for_each(|(y, row)| {
             with_scratch(&ROWS, |scratch| {
-                let texels = &mut scratch.texels;
-                texels.resize(w, Texel::empty());
-                trace_texels(scene, objects, &camera, y, 0..w, &mut scratch.tracing, texels);
+                let RowScratch { tracing, light_hits, shading, texels } = scratch;
+                // On an anchors' row, the anchors' pixels are done.
+                let anchors_row = solution.is_some() && y.is_multiple_of(2);
+                let span = if anchors_row { Span { y, first: 1, step: 2 } } else { Span::whole(y) };
+                texels.resize(span.columns(w).len(), Texel::empty());
+                trace_texels(scene, objects, &camera, span, tracing, texels);
                 if solution.is_some() {
-                    for (x, texel) in texels.iter_mut().enumerate().filter(|(_, t)| t.hit.is_some()) {
-                        let anchor = x.is_multiple_of(2) && y.is_multiple_of(2);
-                        texel.indirect = if anchor { Indirect::Anchor } else { Indirect::Anchors };
+                    for texel in texels.iter_mut().filter(|t| t.hit.is_some()) {
+                        texel.indirect = Indirect::Anchors;
                     }
                 }
-                let rows = Rows { scene, solution, preview, lights: &lights, anchors };
-                rows.shade(y, texels, &[], row, &mut scratch.shading);
+                light_hits.find(&lights, texels);
+                let rows = Rows { scene, solution, preview, lights: &lights, weights: &[], anchors };
+                rows.shade(span, texels, &light_hits.hits, row, shading);
             });
         });
         image
     }
 
-    /// Each anchor's hit and indirect irradiance with the solution's values
-    /// now, for the anchor and the texels between to read: (w/2) × (h/2)
-    /// anchors, rounded up.
+    /// The anchors' pixels, each with its own lookup of the indirect
+    /// irradiance with the solution's values now, into `image`, and the
+    /// anchors, for the pixels between to read: (w/2) × (h/2) of them,
+    /// rounded up.
     ///
     /// An anchor whose camera ray meets a light's surface before its object
     /// lends nothing: the ceiling behind a light is in the light's shadow,
     /// unlike the ceiling beside it that the pixels between may see.
-    fn trace_anchors(&mut self, scene: &Scene, solution: &Radiosity, lights: &Geometry, camera: &CameraRays) {
+    fn shade_anchors(
+        &mut self,
+        scene: &Scene,
+        solution: &Radiosity,
+        preview: &Preview,
+        lights: &Geometry,
+        camera: &CameraRays,
+        image: &mut Image,
+    ) {
         let (w, h) = (scene.settings().width as usize, scene.settings().height as usize);
         let (columns, rows) = (w.div_ceil(2), h.div_ceil(2));
         self.anchors.resize(columns * rows, Anchor::default());
         let objects = &self.objects;
-        self.anchors.par_chunks_mut(columns.max(1)).enumerate().for_each(|(j, row)| {
+        let pairs_of_rows = image.pixels.par_chunks_mut(2 * w.max(1));
+        pairs_of_rows.zip(self.anchors.par_chunks_mut(columns.max(1))).enumerate().for_each(|(j, (pixels, row))| {
             with_scratch(&ROWS, |scratch| {
-                let texels = &mut scratch.texels;
+                let RowScratch { tracing, light_hits, shading, texels } = scratch;
+                let span = Span { y: 2 * j, first: 0, step: 2 };
                 texels.resize(columns, Texel::empty());
-                trace_texels(scene, objects, camera, 2 * j, (0..w).step_by(2), &mut scratch.tracing, texels);
-                let behind_light = lights_in_front(lights, texels.iter());
-                for ((anchor, texel), light) in row.iter_mut().zip(texels.iter()).zip(behind_light) {
+                trace_texels(scene, objects, camera, span, tracing, texels);
+                light_hits.find(lights, texels);
+                for ((anchor, texel), light) in row.iter_mut().zip(texels.iter_mut()).zip(&light_hits.hits) {
                     *anchor = match &texel.hit {
                         Some(_) if light.is_some() => Anchor::default(),
                         Some(s) => {
@@ -99,7 +114,10 @@ impl FirstSample {
                         }
                         None => Anchor::default(),
                     };
+                    texel.indirect = Indirect::Given(anchor.e);
                 }
+                let rows = Rows { scene, solution: Some(solution), preview, lights, weights: &[], anchors: &[] };
+                rows.shade(span, texels, &light_hits.hits, &mut pixels[..w], shading);
             });
         });
     }
