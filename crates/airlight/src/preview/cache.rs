@@ -50,15 +50,20 @@ pub(super) struct Texel {
 }
 
 impl Texel {
-    /// A texel whose camera ray meets no object (yet).
-    pub fn missed(sampler: Sampler, ray: Ray) -> Texel {
+    /// A placeholder, to be overwritten.
+    pub fn empty() -> Texel {
+        let (sampler, ray) = (Sampler::for_pixel(0, 0, 0), Ray::new(Vec3::ZERO, Vec3::Z));
         let (start, len, scale, albedo) = (0, 0, 0.0, Rgb::ZERO);
         Texel { sampler, ray, hit: None, t: f32::INFINITY, albedo, start, len, scale, indirect: Indirect::Own }
     }
 
-    /// A placeholder, to be overwritten.
-    pub fn empty() -> Texel {
-        Texel::missed(Sampler::for_pixel(0, 0, 0), Ray::new(Vec3::ZERO, Vec3::Z))
+    /// Makes this the texel of a camera ray `ray` that meets no object
+    /// (yet), keeping its sampler. Field by field: a whole new texel was
+    /// built on the stack and copied, and the copy's loads waited on the
+    /// stores just before them.
+    fn set_missed(&mut self, ray: Ray) {
+        (self.ray, self.hit, self.t, self.albedo) = (ray, None, f32::INFINITY, Rgb::ZERO);
+        (self.start, self.len, self.scale, self.indirect) = (0, 0, 0.0, Indirect::Own);
     }
 }
 
@@ -225,26 +230,24 @@ pub(super) fn trace_texels(
 ) {
     let s = scene.settings();
     let (w, y) = (s.width as usize, span.y);
-    let Tracing { films, lenses, samplers, rays, hits } = scratch;
+    let Tracing { films, lenses, rays, hits } = scratch;
     // The preview's camera numbers are not stratified: two independent
     // pairs, drawn from the generator the integrator then goes on with.
     films.clear();
     lenses.clear();
-    samplers.clear();
-    for x in span.columns(w) {
-        let mut sampler = Sampler::for_pixel(s.seed, (y * w + x) as u64, 0);
-        let (film, lens) = film_sample(s.filter, false, x as u32, y as u32, &mut sampler);
+    for (texel, x) in out.iter_mut().zip(span.columns(w)) {
+        texel.sampler = Sampler::for_pixel(s.seed, (y * w + x) as u64, 0);
+        let (film, lens) = film_sample(s.filter, false, x as u32, y as u32, &mut texel.sampler);
         films.push(film);
         lenses.push(lens);
-        samplers.push(sampler);
     }
     rays.clear();
     camera.rays_into(films, lenses, rays);
     hits.clear();
     hits.resize(rays.len(), None);
     objects.intersect_packet(rays, f32::INFINITY, hits);
-    for (((texel, &ray), &hit), sampler) in out.iter_mut().zip(rays.iter()).zip(hits.iter()).zip(samplers.drain(..)) {
-        *texel = Texel::missed(sampler, ray);
+    for ((texel, &ray), &hit) in out.iter_mut().zip(rays.iter()).zip(hits.iter()) {
+        texel.set_missed(ray);
         if let Some(hit) = hit {
             let surface = objects.surface(&ray, hit);
             texel.hit = Some(surface);
@@ -259,7 +262,6 @@ pub(super) fn trace_texels(
 pub(super) struct Tracing {
     films: Vec<Vec2>,
     lenses: Vec<Vec2>,
-    samplers: Vec<Sampler>,
     rays: Vec<Ray>,
     hits: Vec<Option<Hit>>,
 }
