@@ -439,7 +439,8 @@ impl Geometry {
         let (index, id) = (hit.id as usize, hit.id);
         match self.records.get(index) {
             Some(rec) => {
-                let n = self.small.as_ref().and_then(|s| s.quad_normal(index)).unwrap_or_else(|| rec.prim.normal(p));
+                let known = self.small.as_ref().and_then(|s| s.known_normal(index, &rec.prim, p));
+                let n = known.unwrap_or_else(|| rec.prim.normal(p));
                 SurfaceHit { p, n, material: rec.material, emitter: rec.emitter, id }
             }
             None => match self.planes.get(index - self.records.len()) {

@@ -50,6 +50,14 @@ pub(super) struct Instance {
     pub bounds: Aabb,
 }
 
+impl Instance {
+    /// The unit world normal of a local normal.
+    #[inline]
+    pub fn world_normal(&self, local: Vec3) -> Vec3 {
+        (self.normal_to_world * local).normalize()
+    }
+}
+
 #[derive(Clone, Debug)]
 pub(super) struct Record {
     pub prim: Prim,
@@ -120,10 +128,7 @@ impl Prim {
             Prim::Quad { edge_u, edge_v, .. } => edge_u.cross(*edge_v).normalize(),
             Prim::Box { min, max } => box_normal(*min, *max, p),
             Prim::Triangle { e1, e2, .. } => e1.cross(*e2).normalize(),
-            Prim::Instance(inst) => {
-                let local = inst.prim.normal(inst.local_from_world.transform_point3(p));
-                (inst.normal_to_world * local).normalize()
-            }
+            Prim::Instance(inst) => inst.world_normal(inst.prim.normal(inst.local_from_world.transform_point3(p))),
             Prim::Sdf(s) => s.sdf.normal(p),
         }
     }

@@ -298,17 +298,31 @@ pub fn triangle_blocks(v0: Vec3, e1: Vec3, e2: Vec3, o: Vec3, d: Vec3, tmax: f32
 /// The outward normal of an axis-aligned box at a point on its surface: the
 /// axis of the face the point lies closest to.
 pub fn box_normal(min: Vec3, max: Vec3, p: Vec3) -> Vec3 {
+    box_face(min, max, p).map_or(Vec3::ZERO, box_face_normal)
+}
+
+/// The face of the box nearest `p`: 2·axis for the face at `min`, 2·axis +
+/// 1 for the one at `max`, the first of equals; None where no distance is
+/// finite (a NaN point).
+#[inline]
+pub(crate) fn box_face(min: Vec3, max: Vec3, p: Vec3) -> Option<usize> {
     let to_min = (p - min).abs();
     let to_max = (max - p).abs();
-    let mut best = (f32::INFINITY, Vec3::ZERO);
+    let mut best = (f32::INFINITY, None);
     for axis in 0..3 {
-        let e = Vec3::AXES[axis];
         if to_min[axis] < best.0 {
-            best = (to_min[axis], -e);
+            best = (to_min[axis], Some(2 * axis));
         }
         if to_max[axis] < best.0 {
-            best = (to_max[axis], e);
+            best = (to_max[axis], Some(2 * axis + 1));
         }
     }
     best.1
+}
+
+/// The outward normal of face `face` ([`box_face`]) of an axis-aligned box.
+#[inline]
+pub(crate) fn box_face_normal(face: usize) -> Vec3 {
+    let e = Vec3::AXES[face / 2];
+    if face % 2 == 1 { e } else { -e }
 }

@@ -22,6 +22,7 @@ use super::batch::{comes_before, test_bound};
 use super::box_lanes::BoxLanes;
 use super::quad_lanes::QuadLanes;
 use super::records::{Prim, Record};
+use super::shape::{box_face, box_face_normal};
 use crate::isa::Isa;
 use glam::{Affine3A, Vec3};
 
@@ -41,10 +42,10 @@ pub(super) struct Small {
     quads: QuadLanes,
     boxes: BoxLanes,
     others: Vec<Other>,
-    /// Each record's unit normal if it is a quad (whose normal is the same
-    /// everywhere): the normal of each hit without a square root and a
-    /// division of its own.
-    quad_normals: Vec<Option<Vec3>>,
+    /// Each record's unit normals where they are few and known: a quad's,
+    /// the same everywhere, and a turned box's six; the normal of each hit
+    /// without a square root and a division of its own.
+    normals: Vec<KnownNormals>,
     /// The instructions the tests run on.
     isa: Isa,
 }
@@ -113,18 +114,48 @@ pub(super) fn small_scene(records: &[Record]) -> Option<Small> {
             others.push(Other { index, center: 0.5 * (min + max), radius_squared: radius * radius });
         }
     }
-    // `Prim::normal`'s own arithmetic, done once: the same bits.
-    let quad_normals =
-        records.iter().map(|r| matches!(r.prim, Prim::Quad { .. }).then(|| r.prim.normal(Vec3::ZERO))).collect();
+    let normals = records.iter().map(|r| KnownNormals::of(&r.prim)).collect();
     let (quads, boxes) = (QuadLanes::new(&quads), BoxLanes::new(&boxes));
-    Some(Small { quads, boxes, others, quad_normals, isa: Isa::best() })
+    Some(Small { quads, boxes, others, normals, isa: Isa::best() })
+}
+
+/// A record's unit normals, found once with `Prim::normal`'s own
+/// arithmetic, so the same bits.
+#[derive(Clone, Debug)]
+enum KnownNormals {
+    None,
+    Quad(Vec3),
+    /// A turned box's faces', in [`box_face`]'s order.
+    TurnedBox([Vec3; 6]),
+}
+
+impl KnownNormals {
+    fn of(prim: &Prim) -> KnownNormals {
+        match prim {
+            Prim::Quad { .. } => KnownNormals::Quad(prim.normal(Vec3::ZERO)),
+            Prim::Instance(inst) if matches!(inst.prim, Prim::Box { .. }) => {
+                KnownNormals::TurnedBox(std::array::from_fn(|face| inst.world_normal(box_face_normal(face))))
+            }
+            _ => KnownNormals::None,
+        }
+    }
 }
 
 impl Small {
-    /// The unit normal of record `index` if it is a quad.
+    /// The unit normal of record `index` (whose primitive is `prim`) at
+    /// its point `p` if it is a quad or a turned box: [`Prim::normal`]'s.
     #[inline]
-    pub fn quad_normal(&self, index: usize) -> Option<Vec3> {
-        self.quad_normals.get(index).copied().flatten()
+    pub fn known_normal(&self, index: usize, prim: &Prim, p: Vec3) -> Option<Vec3> {
+        match (self.normals.get(index)?, prim) {
+            (KnownNormals::Quad(n), _) => Some(*n),
+            (KnownNormals::TurnedBox(faces), Prim::Instance(inst)) => match inst.prim {
+                Prim::Box { min, max } => {
+                    box_face(min, max, inst.local_from_world.transform_point3(p)).map(|face| faces[face])
+                }
+                _ => None,
+            },
+            _ => None,
+        }
     }
 
     /// Keeps in `best` the nearest hit of the ray `o + t·d`, 0 < t < tmax,
@@ -294,5 +325,40 @@ mod tests {
         }
         // Most rays start inside the room; the short ones may stop short.
         assert!(hits > 12_000, "hits {hits}");
+    }
+
+    /// The normals kept for quads and turned boxes are the ones
+    /// `Prim::normal` finds at each hit, to the bit.
+    #[test]
+    fn known_normals_are_the_primitives_own() {
+        let mut records = room();
+        let world_from_local = Affine3A::from_rotation_translation(
+            glam::Quat::from_axis_angle(vec3(0.3, 1.0, 0.2).normalize(), 0.7),
+            vec3(-0.2, 0.9, -0.5),
+        );
+        let instance = super::super::records::Instance {
+            prim: Prim::Box { min: vec3(-0.2, -0.3, -0.1), max: vec3(0.2, 0.3, 0.1) },
+            local_from_world: world_from_local.inverse(),
+            normal_to_world: glam::Mat3::from(world_from_local.matrix3).inverse().transpose(),
+            bounds: obvhs::aabb::Aabb::empty(),
+        };
+        records.push(Record { prim: Prim::Instance(Box::new(instance)), material: 0, emitter: None, uv: NO_UV });
+        let turned = records.len() - 1;
+        let small = small_scene(&records).expect("a small scene");
+        let mut s = Sampler::for_pixel(5, 2, 7);
+        let mut known = [0; 2];
+        for _ in 0..20_000 {
+            let o = vec3(2.0 * s.next() - 1.0, 2.0 * s.next(), 2.0 * s.next() - 1.0);
+            let d = uniform_sphere(s.next2());
+            let mut hit = Hit { t: f32::INFINITY, id: u32::MAX };
+            small.nearest(&records, o, d, f32::INFINITY, &mut hit);
+            let Some(record) = records.get(hit.id as usize) else { continue };
+            let p = o + d * hit.t;
+            if let Some(n) = small.known_normal(hit.id as usize, &record.prim, p) {
+                assert_eq!(n.to_array().map(f32::to_bits), record.prim.normal(p).to_array().map(f32::to_bits));
+                known[(hit.id as usize == turned) as usize] += 1;
+            }
+        }
+        assert!(known[0] > 10_000 && known[1] > 200, "{known:?} quads' and the turned box's");
     }
 }
