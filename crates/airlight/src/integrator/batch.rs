@@ -11,6 +11,7 @@ use crate::medium::Medium;
 use crate::sampling::Sampler;
 use crate::scene::Scene;
 use crate::scratch::with_scratch;
+use glam::Vec3;
 use std::cell::RefCell;
 
 /// Direct light whose shadow rays are put off: the light terms of many
@@ -67,8 +68,16 @@ impl DeferredShadows {
         order.clear();
         order.extend((0..candidates.len()).filter(|&c| candidates[c].segment.is_some()));
         order.sort_by_key(|&c| candidates[c].light);
+        // Field by field into place: a push of each whole segment went
+        // through the stack, its load waiting on the stores before it.
+        let none = Segment { origin: Vec3::ZERO, dir: Vec3::Z, tmax: 0.0 };
         segments.clear();
-        segments.extend(order.iter().filter_map(|&c| candidates[c].segment));
+        segments.resize(order.len(), none);
+        for (segment, &c) in segments.iter_mut().zip(order.iter()) {
+            if let Some(s) = &candidates[c].segment {
+                (segment.origin, segment.dir, segment.tmax) = (s.origin, s.dir, s.tmax);
+            }
+        }
         blocked_sorted.clear();
         blocked_sorted.resize(segments.len(), false);
         scene.geometry().occluded_packet(segments, blocked_sorted);
