@@ -315,21 +315,23 @@ impl Rows<'_> {
         samplers.clear();
         shadows.clear();
         radiance.clear();
-        for (k, (texel, light_hit)) in texels.iter().zip(light_hits).enumerate() {
-            let mut sampler = texel.sampler.clone();
-            let ray = &texel.ray;
+        // (Copied all at once: one at a time, each went through the stack.)
+        samplers.extend(texels.iter().map(|texel| texel.sampler.clone()));
+        for ((texel, light_hit), sampler) in texels.iter().zip(light_hits).zip(samplers.iter_mut()) {
+            let (ray, k) = (&texel.ray, radiance.len());
             radiance.push(match (light_hit, &texel.hit) {
                 // A light's surface in front of the objects (it reflects nothing).
-                (Some(hit), _) => shadows.surface(scene, ray, &lights.surface(ray, *hit), &mut sampler, k),
-                (None, Some(s)) => shadows.surface(scene, ray, s, &mut sampler, k),
+                (Some(hit), _) => shadows.surface(scene, ray, &lights.surface(ray, *hit), sampler, k),
+                (None, Some(s)) => shadows.surface(scene, ray, s, sampler, k),
                 (None, None) => scene.settings().background,
             });
-            samplers.push(sampler);
         }
         shadows.resolve(scene, scene.medium(), radiance);
         for (k, (x, (texel, light_hit))) in span.columns(w).zip(texels.iter().zip(light_hits)).enumerate() {
             let ray = &texel.ray;
-            let out = &mut radiance[k];
+            // A local copy: added to in memory, its parts were stored one
+            // by one and read back together, which waits on the stores.
+            let mut out = radiance[k];
             let t_end = match (light_hit, &texel.hit) {
                 (Some(hit), _) => hit.t,
                 (None, Some(s)) => {
@@ -340,14 +342,14 @@ impl Rows<'_> {
                             Indirect::Anchors => between_anchors(anchors, solution, s, ray, (x, y), (w, h)),
                         };
                         if let Some(e) = e {
-                            *out += texel.albedo * e;
+                            out += texel.albedo * e;
                         }
                     }
                     texel.t
                 }
                 (None, None) => scene.settings().max_distance,
             };
-            let l = through_medium(scene, ray, *out, t_end, &mut samplers[k], |medium, length, sampler| {
+            let l = through_medium(scene, ray, out, t_end, &mut samplers[k], |medium, length, sampler| {
                 preview.glow(scene, medium, ray, length, sampler)
             });
             row[x] = if l.is_finite() { l } else { Rgb::ZERO };
