@@ -81,6 +81,27 @@ pub fn from_bf16(b: u16) -> f32 {
     f32::from_bits((b as u32) << 16)
 }
 
+/// Σ b(source) · factor over one receiver's links, in four running sums
+/// (links 4k, 4k + 1, 4k + 2, 4k + 3, the last few in the first) added at
+/// the end as (s0 + s1) + (s2 + s3): one running sum made every add wait for
+/// the one before, and the gather ran at the adder's latency. The order is
+/// fixed by the links alone, so the answer does not depend on the threads.
+#[inline(always)]
+fn weighted_sum<S: Copy>(sources: &[S], factors: &[u16], b: &[glam::Vec3A], index: impl Fn(S) -> usize) -> glam::Vec3A {
+    let mut sums = [glam::Vec3A::ZERO; 4];
+    let (quads, rest) = (sources.chunks_exact(4), factors.chunks_exact(4));
+    let (tail_sources, tail_factors) = (quads.remainder(), rest.remainder());
+    for (sources, factors) in quads.zip(rest) {
+        for j in 0..4 {
+            sums[j] += b[index(sources[j])] * from_bf16(factors[j]);
+        }
+    }
+    for (&src, &f) in tail_sources.iter().zip(tail_factors) {
+        sums[0] += b[index(src)] * from_bf16(f);
+    }
+    (sums[0] + sums[1]) + (sums[2] + sums[3])
+}
+
 impl Links {
     /// Total number of links.
     pub fn len(&self) -> usize {
@@ -108,20 +129,10 @@ impl Links {
     pub fn gather(&self, receiver: usize, b: &[glam::Vec3A]) -> glam::Vec3A {
         let range = self.offsets[receiver] as usize..self.offsets[receiver + 1] as usize;
         let factors = &self.factors[range.clone()];
-        let mut sum = glam::Vec3A::ZERO;
         match &self.sources {
-            Sources::Narrow(s) => {
-                for (&src, &f) in s[range].iter().zip(factors) {
-                    sum += b[src as usize] * from_bf16(f);
-                }
-            }
-            Sources::Wide(s) => {
-                for (&src, &f) in s[range].iter().zip(factors) {
-                    sum += b[src as usize] * from_bf16(f);
-                }
-            }
+            Sources::Narrow(s) => weighted_sum(&s[range], factors, b, |src| src as usize),
+            Sources::Wide(s) => weighted_sum(&s[range], factors, b, |src| src as usize),
         }
-        sum
     }
 
     pub fn bytes(&self) -> usize {
