@@ -52,3 +52,28 @@ fn blocks_do_not_change_the_links() {
         assert_eq!(whole, blocked, "receiver share {share}");
     }
 }
+
+/// The gather's four running sums give Σ b(source)·factor: against the
+/// sum in f64, one link at a time, for lists of 0 to 40 links (each
+/// remainder of four) with repeated sources, to f32 rounding.
+#[test]
+fn the_weighted_sum_is_the_sum_of_its_terms() {
+    let b: Vec<glam::Vec3A> = (0..50u64)
+        .map(|k| {
+            let h = hierarchy::mix(k);
+            glam::Vec3A::new((h & 0xff) as f32 / 64.0, ((h >> 8) & 0xff) as f32 / 64.0, ((h >> 16) & 0xff) as f32)
+        })
+        .collect();
+    for n in 0..=40u64 {
+        let sources: Vec<u16> = (0..n).map(|k| (hierarchy::mix(n * 100 + k) % 50) as u16).collect();
+        let factors: Vec<u16> =
+            (0..n).map(|k| to_bf16((hierarchy::mix(n * 1000 + k) % 1000) as f32 / 3000.0)).collect();
+        let got = weighted_sum(&sources, &factors, &b, |s| s as usize);
+        let mut want = glam::DVec3::ZERO;
+        for (&s, &f) in sources.iter().zip(&factors) {
+            want += b[s as usize].as_dvec3() * from_bf16(f) as f64;
+        }
+        let scale = want.abs().max_element().max(1.0);
+        assert!((got.as_dvec3() - want).abs().max_element() <= 1e-5 * scale, "{n} links: {got} against {want}");
+    }
+}
