@@ -77,8 +77,14 @@ impl Material {
     pub fn lambertian_brdf(&self, p: Vec3, n: Vec3) -> Option<Rgb> {
         match self {
             Material::Phong { .. } => None,
-            _ => Some(self.albedo(p, n) / PI),
+            _ => Some(self.diffuse_brdf(p, n)),
         }
+    }
+
+    /// The diffuse part of the BRDF at `p`: albedo/π.
+    #[inline]
+    fn diffuse_brdf(&self, p: Vec3, n: Vec3) -> Rgb {
+        self.albedo(p, n) / PI
     }
 
     /// The BRDF for outgoing `wo` and incident `wi` (both pointing away from
@@ -89,7 +95,7 @@ impl Material {
         if n.dot(wo) * n.dot(wi) <= 0.0 {
             return Rgb::ZERO;
         }
-        let diffuse = self.albedo(p, n) / PI;
+        let diffuse = self.diffuse_brdf(p, n);
         match *self {
             Material::Phong { specular, exponent, .. } => {
                 // Both directions on one side of the surface, for the lobe.

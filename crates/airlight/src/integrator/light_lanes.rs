@@ -4,8 +4,8 @@
 //! every other light and every glossy point one at a time.
 //!
 //! One point's light term is a chain of a square root, four divisions and
-//! the tests between them, which a processor runs one after another; eight
-//! points' chains in lanes take about as long as one. The lanes do
+//! the tests between them, which a processor runs one after another; in
+//! lanes, eight points' chains run side by side. The lanes do
 //! [`light_term`]'s operations in its order (Rust never fuses a multiply
 //! and an add), so each term is the same to the bit, and each point's terms
 //! still come in the lights' order, as its sum wants them.

@@ -11,11 +11,11 @@
 //! add on its own), so the hits are the same bit for bit. On an Intel Xeon
 //! with AVX-512 the Cornell box's path tracing took 0.94× the baseline's
 //! time on AVX2 and 0.91× on AVX-512, the viewer's flight 0.90× and 0.86×
-//! (6 side-by-side pairs each). Everything the tests do must inline into each copy: the
-//! shadow test's `Iterator::any` with a closure was compiled apart, for the
-//! baseline, and cost 1.06×, so the loops here and in the lanes are plain
-//! `for` loops. (The quads' lanes alone compiled for AVX gave no gain on an
-//! AMD Zen 5: the divisions take as long.)
+//! (6 side-by-side pairs each). Everything the tests do must inline into
+//! each copy: the shadow test's `Iterator::any` with a closure was compiled
+//! apart, for the baseline, and cost 1.06×, so the loops here and in the
+//! lanes are plain `for` loops. (The quads' lanes alone compiled for AVX
+//! gave no gain on an AMD Zen 5: the divisions take as long.)
 
 use super::Hit;
 use super::batch::{comes_before, test_bound};
