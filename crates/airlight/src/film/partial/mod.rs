@@ -19,8 +19,13 @@
 //! up to the very sums one render makes: the merged image is the same, bit
 //! for bit.
 
+mod header;
+mod merge;
+
+pub use merge::{merge, piece};
+
 use super::{Accumulator, PixelSum};
-use std::collections::BTreeMap;
+use header::{header_text, parse_header};
 use std::io::{self, Write};
 use std::ops::Range;
 use std::path::Path;
@@ -157,12 +162,6 @@ pub fn encode(header: &PartialHeader, sums: &Accumulator) -> io::Result<Vec<u8>>
     encode_with_attributes(header, sums, &[(FIELDS_ATTRIBUTE, header_text(header))])
 }
 
-/// The header's fields as the text of the [`FIELDS_ATTRIBUTE`]: a
-/// `key=value` line each.
-fn header_text(header: &PartialHeader) -> String {
-    header_fields(header).iter().map(|(key, value)| format!("{key}={value}\n")).collect()
-}
-
 /// The EXR bytes of the sums with these text attributes in the header.
 fn encode_with_attributes(
     header: &PartialHeader,
@@ -263,228 +262,14 @@ impl exr::image::write::samples::SamplesWriter for SumWords<'_> {
     }
 }
 
-/// The header's fields as (key, value) text, in a fixed order, the format
-/// tag first.
-fn header_fields(h: &PartialHeader) -> Vec<(&'static str, String)> {
-    vec![
-        ("format", PARTIAL_FORMAT.to_string()),
-        ("version", h.version.clone()),
-        ("scene", h.scene.clone()),
-        ("seed", h.seed.to_string()),
-        ("width", h.width.to_string()),
-        ("height", h.height.to_string()),
-        ("spp", h.spp.to_string()),
-        ("samples", format!("{}..{}", h.samples.start, h.samples.end)),
-        ("rows", format!("{}..{}", h.rows.start, h.rows.end)),
-        ("frame", h.frame.map_or("-".into(), |(k, n)| format!("{k}/{n}"))),
-        // Shortest text that reads back as the same f32.
-        ("exposure", format!("{:?}", h.exposure)),
-        ("tonemap", h.tonemap.name().to_string()),
-    ]
-}
-
-/// The fields of a header's text attributes: the lines of
-/// [`FIELDS_ATTRIBUTE`], or else (the first format) the attributes named
-/// `airlight.<key>`.
-fn read_fields(
-    attributes: &std::collections::HashMap<exr::meta::attribute::Text, exr::meta::attribute::AttributeValue>,
-) -> Result<BTreeMap<String, String>, String> {
-    use exr::meta::attribute::AttributeValue;
-    let texts = attributes.iter().filter_map(|(key, value)| match value {
-        AttributeValue::Text(text) => Some((key.to_string(), text.to_string())),
-        _ => None,
-    });
-    let mut fields = BTreeMap::new();
-    let mut packed = None;
-    for (key, value) in texts {
-        if key == FIELDS_ATTRIBUTE {
-            packed = Some(value);
-        } else if let Some(field) = key.strip_prefix("airlight.") {
-            fields.insert(field.to_string(), value);
-        }
-    }
-    if let Some(lines) = packed {
-        fields.clear();
-        for line in lines.lines() {
-            let (key, value) = line
-                .split_once('=')
-                .ok_or_else(|| format!("its header's `{FIELDS_ATTRIBUTE}` has a line without `=`: `{line}`"))?;
-            fields.insert(key.to_string(), value.to_string());
-        }
-    }
-    Ok(fields)
-}
-
-fn parse_header(
-    attributes: &std::collections::HashMap<exr::meta::attribute::Text, exr::meta::attribute::AttributeValue>,
-) -> Result<PartialHeader, String> {
-    let fields = read_fields(attributes)?;
-    let get = |key: &str| -> Result<String, String> {
-        fields.get(key).cloned().ok_or_else(|| format!("not an Airlight partial render (no `{key}` in its header)"))
-    };
-    let format = get("format")?;
-    if format != PARTIAL_FORMAT && format != PARTIAL_FORMAT_1 {
-        return Err(format!(
-            "a partial render of format `{format}`; this Airlight reads `{PARTIAL_FORMAT}` and `{PARTIAL_FORMAT_1}`"
-        ));
-    }
-    let number = |key: &str| -> Result<u64, String> {
-        get(key)?.parse().map_err(|_| format!("its header's `{key}` is not a whole number"))
-    };
-    let range = |key: &str| -> Result<Range<u64>, String> {
-        let text = get(key)?;
-        let (a, b) = text.split_once("..").ok_or_else(|| format!("its header's `{key}` is not a range a..b"))?;
-        let parse = |s: &str| s.parse::<u64>().map_err(|_| format!("its header's `{key}` is not a range a..b"));
-        let (a, b) = (parse(a)?, parse(b)?);
-        if a > b {
-            return Err(format!("its header's `{key}` runs backwards: {a}..{b}"));
-        }
-        Ok(a..b)
-    };
-    let small = |v: u64, key: &str| u32::try_from(v).map_err(|_| format!("its header's `{key}` is too large: {v}"));
-    let (width, height) = (small(number("width")?, "width")?, small(number("height")?, "height")?);
-    let spp = small(number("spp")?, "spp")?;
-    let samples = range("samples")?;
-    let rows = range("rows")?;
-    if samples.end > spp as u64 || rows.end > height as u64 {
-        return Err(format!(
-            "its header's samples {samples:?} or rows {rows:?} lie outside the image's {spp} spp or {height} rows"
-        ));
-    }
-    if width as u64 * (rows.end - rows.start) > crate::scene::MAX_PIXELS {
-        return Err(format!(
-            "its header declares {width}×{} pixels, more than Airlight renders",
-            rows.end - rows.start
-        ));
-    }
-    let frame = match get("frame")?.as_str() {
-        "-" => None,
-        text => {
-            let bad = || format!("its header's frame `{text}` is not k/n");
-            let (k, n) = text.split_once('/').ok_or_else(bad)?;
-            Some((k.parse().map_err(|_| bad())?, n.parse().map_err(|_| bad())?))
-        }
-    };
-    let exposure = get("exposure")?
-        .parse::<f32>()
-        .ok()
-        .filter(|e| e.is_finite())
-        .ok_or("its header's `exposure` is not a finite number")?;
-    let tonemap = get("tonemap")?.parse().map_err(|e| format!("its header's `tonemap`: {e}"))?;
-    Ok(PartialHeader {
-        exposure,
-        tonemap,
-        version: get("version")?,
-        scene: get("scene")?,
-        seed: number("seed")?,
-        width,
-        height,
-        spp,
-        samples,
-        rows: rows.start as u32..rows.end as u32,
-        frame,
-    })
-}
-
-/// Adds up partial renders of one image, after checking that they are of
-/// the same scene, seed, size, spp and frame, and that together they hold
-/// every sample of every pixel exactly once. `parts` pairs each partial
-/// with the name it is reported by (its file). The error names what is
-/// mismatched, missing or held twice.
-pub fn merge(parts: &[(String, Partial)]) -> Result<(PartialHeader, Accumulator), String> {
-    let Some((first_name, first)) = parts.first() else {
-        return Err("no partial renders to merge".into());
-    };
-    let a = &first.header;
-    for (name, part) in &parts[1..] {
-        let b = &part.header;
-        let differ = |what: &str, x: &dyn std::fmt::Display, y: &dyn std::fmt::Display| {
-            Err(format!("{name} and {first_name} are of different renders: {what} {y} and {x}"))
-        };
-        if b.seed != a.seed {
-            return differ("seed", &a.seed, &b.seed);
-        }
-        if (b.width, b.height) != (a.width, a.height) {
-            return differ("size", &format!("{}×{}", a.width, a.height), &format!("{}×{}", b.width, b.height));
-        }
-        if b.spp != a.spp {
-            return differ("spp", &a.spp, &b.spp);
-        }
-        if b.frame != a.frame {
-            return differ("frame", &format!("{:?}", a.frame), &format!("{:?}", b.frame));
-        }
-        if b.version != a.version {
-            return differ("Airlight version", &a.version, &b.version);
-        }
-        // Last: the fingerprint covers the fields above too, which are
-        // named more plainly on their own.
-        if b.scene != a.scene {
-            return differ("scene fingerprint", &a.scene, &b.scene);
-        }
-    }
-    check_coverage(parts, a.height, a.spp as u64)?;
-    let mut total = Accumulator::new(a.width, a.height);
-    for (name, part) in parts {
-        total.merge(&part.sums).map_err(|e| format!("{name}: {e}"))?;
-    }
-    let header = PartialHeader { samples: 0..a.spp as u64, rows: 0..a.height, ..a.clone() };
-    Ok((header, total))
-}
-
-/// Checks that the parts' rectangles (rows × sample numbers) tile
-/// [0, height) × [0, spp) exactly.
-fn check_coverage(parts: &[(String, Partial)], height: u32, spp: u64) -> Result<(), String> {
-    let mut cuts: Vec<u32> = vec![0, height];
-    for (_, p) in parts {
-        cuts.extend([p.header.rows.start, p.header.rows.end]);
-    }
-    cuts.sort_unstable();
-    cuts.dedup();
-    for band in cuts.windows(2) {
-        let (r0, r1) = (band[0], band[1]);
-        let mut spans: Vec<(u64, u64, &str)> = parts
-            .iter()
-            .filter(|(_, p)| p.header.rows.start <= r0 && p.header.rows.end >= r1)
-            .filter(|(_, p)| !p.header.samples.is_empty())
-            .map(|(name, p)| (p.header.samples.start, p.header.samples.end, name.as_str()))
-            .collect();
-        spans.sort_unstable();
-        let mut next = 0u64;
-        let mut last_name = "";
-        for (s0, s1, name) in spans {
-            if s0 > next {
-                return Err(format!("samples {next}..{s0} of rows {r0}..{r1} are in no part"));
-            }
-            if s0 < next {
-                return Err(format!(
-                    "{name} and {last_name} both hold samples {s0}..{} of rows {r0}..{r1}",
-                    next.min(s1)
-                ));
-            }
-            next = s1;
-            last_name = name;
-        }
-        if next < spp {
-            return Err(format!("samples {next}..{spp} of rows {r0}..{r1} are in no part"));
-        }
-    }
-    Ok(())
-}
-
-/// The `k`-th of `n` contiguous, near-equal pieces of `0..total` (the
-/// first `total % n` pieces one longer).
-pub fn piece(total: u64, k: u64, n: u64) -> Range<u64> {
-    let (base, extra) = (total / n, total % n);
-    let start = k * base + k.min(extra);
-    start..start + base + u64::from(k < extra)
-}
-
 #[cfg(test)]
 mod tests {
+    use super::header::header_fields;
     use super::*;
     use crate::Rgb;
 
-    fn part(rows: Range<u32>, samples: Range<u64>, seed: u64) -> Partial {
+    /// A partial of a 3×4 image: these rows and samples of made-up sums.
+    pub(super) fn part(rows: Range<u32>, samples: Range<u64>, seed: u64) -> Partial {
         let mut sums = Accumulator::band(3, 4, rows.clone());
         let first = rows.start as usize * 3;
         for (i, p) in sums.pixels_mut().iter_mut().enumerate() {
@@ -552,34 +337,5 @@ mod tests {
         std::fs::write(&path, encode_with_attributes(&p.header, &p.sums, &unknown).unwrap()).unwrap();
         let e = Partial::read(&path).unwrap_err();
         assert!(e.contains("of format `airlight-partial-9`"), "{e}");
-    }
-
-    #[test]
-    fn pieces_split_evenly_and_cover_the_whole() {
-        for (total, n) in [(10u64, 3u64), (7, 7), (3, 4), (1000, 7)] {
-            let ranges: Vec<_> = (0..n).map(|k| piece(total, k, n)).collect();
-            assert_eq!(ranges[0].start, 0);
-            assert_eq!(ranges[n as usize - 1].end, total);
-            assert!(ranges.windows(2).all(|w| w[0].end == w[1].start));
-            let sizes: Vec<u64> = ranges.iter().map(|r| r.end - r.start).collect();
-            assert!(sizes.iter().max().unwrap() - sizes.iter().min().unwrap() <= 1, "{sizes:?}");
-        }
-    }
-
-    #[test]
-    fn merging_checks_coverage_and_sameness() {
-        let named = |parts: Vec<Partial>| -> Vec<(String, Partial)> {
-            parts.into_iter().enumerate().map(|(i, p)| (format!("part{i}"), p)).collect()
-        };
-        let whole = part(0..4, 0..5, 7);
-        let split = named(vec![part(0..2, 0..5, 7), part(2..4, 0..3, 7), part(2..4, 3..5, 7)]);
-        let (_, merged) = merge(&split).unwrap();
-        assert_eq!(merged, whole.sums);
-        let missing = merge(&named(vec![part(0..2, 0..5, 7), part(2..4, 0..3, 7)])).unwrap_err();
-        assert!(missing.contains("samples 3..5 of rows 2..4 are in no part"), "{missing}");
-        let overlap = merge(&named(vec![part(0..4, 0..5, 7), part(2..4, 1..2, 7)])).unwrap_err();
-        assert!(overlap.contains("both hold samples 1..2 of rows 2..4"), "{overlap}");
-        let seed = merge(&named(vec![part(0..2, 0..5, 7), part(2..4, 0..5, 8)])).unwrap_err();
-        assert!(seed.contains("seed 8 and 7"), "{seed}");
     }
 }
