@@ -11,7 +11,8 @@
 //! (`meshes[2].primitives[0]`) and what is wrong.
 
 use super::assets::{MAX_MESH_BYTES, read_limited};
-use super::build::{Built, Checker, Result};
+use super::build::{Checker, Result};
+use super::build_objects::Built;
 use crate::camera::Camera;
 use crate::geometry::Shape;
 use crate::light::{Attenuation, Light, SpotProfile};

@@ -14,6 +14,7 @@ mod build_camera;
 mod build_lights;
 mod build_materials;
 mod build_medium;
+mod build_objects;
 pub mod desc;
 mod emitters;
 mod error;

@@ -1,0 +1,327 @@
+//! Objects of a scene file: each `[[objects]]` table's shape, its place
+//! (transform), its material and, for emitting surfaces, its lights; and
+//! each `[[include]]`d glTF file's meshes.
+
+use super::build::{Checker, Result};
+use super::desc::*;
+use super::gltf;
+use super::limits;
+use crate::Rgb;
+use crate::geometry::Shape;
+use crate::light::Light;
+use crate::material::Material;
+use glam::{Affine3A, Quat, Vec3};
+use std::ops::Range;
+use toml::Spanned;
+
+/// What one `[[objects]]` table builds: surfaces with the names of their
+/// materials, the materials it brings (an OBJ's `.mtl`), and the lights
+/// of emitting surfaces.
+#[derive(Default)]
+pub(super) struct Built {
+    pub materials: Vec<(String, Material)>,
+    pub objects: Vec<(Shape, String)>,
+    pub lights: Vec<Light>,
+}
+
+impl Checker<'_> {
+    pub(super) fn object(&self, index: usize, desc: &Spanned<ObjectDesc>, scene: &SceneDesc) -> Result<Built> {
+        let span = desc.span();
+        let o = desc.get_ref();
+        let kind = format!("{:?}", o.kind).to_lowercase();
+        let label = format!("objects[{index}] ({kind})");
+        let fields: [(&str, bool); 18] = [
+            ("shape", o.shape.is_some()),
+            ("children", o.children.is_some()),
+            ("blend", o.blend.is_some()),
+            ("a", o.a.is_some()),
+            ("b", o.b.is_some()),
+            ("major_radius", o.major_radius.is_some()),
+            ("minor_radius", o.minor_radius.is_some()),
+            ("rounding", o.rounding.is_some()),
+            ("center", o.center.is_some()),
+            ("radius", o.radius.is_some()),
+            ("point", o.point.is_some()),
+            ("normal", o.normal.is_some()),
+            ("corner", o.corner.is_some()),
+            ("edge_u", o.edge_u.is_some()),
+            ("edge_v", o.edge_v.is_some()),
+            ("min", o.min.is_some()),
+            ("max", o.max.is_some()),
+            ("file", o.file.is_some()),
+        ];
+        let takes: &[&str] = match o.kind {
+            ObjectType::Sphere => &["center", "radius"],
+            ObjectType::Plane => &["point", "normal"],
+            ObjectType::Quad => &["corner", "edge_u", "edge_v"],
+            ObjectType::Box => &["min", "max"],
+            ObjectType::Mesh => &["file"],
+            // The node's own shape decides (sdf.rs); other types' fields are not for it.
+            ObjectType::Sdf => {
+                let sdf_fields = fields.iter().filter(|(n, _)| !matches!(*n, "corner" | "edge_u" | "edge_v" | "file"));
+                let names: Vec<&str> = sdf_fields.map(|(n, _)| *n).collect();
+                self.check_fields(span.clone(), &label, &kind, &fields, &[], &names)?;
+                &[]
+            }
+        };
+        if o.kind != ObjectType::Sdf {
+            self.check_fields(span.clone(), &label, &kind, &fields, takes, &[])?;
+        }
+        if o.kind == ObjectType::Mesh && o.material.is_none() && o.emission.is_none() {
+            let transform = self.transform(span.clone(), &label, o)?;
+            return self.mesh_with_materials(span, &label, o.file.as_ref().unwrap(), transform);
+        }
+        let get = |p: Option<Point>, name: &str| self.finite3(span.clone(), &format!("{label}.{name}"), p.unwrap().0);
+        let shape = match o.kind {
+            ObjectType::Sphere => {
+                let radius = self.positive(span.clone(), &format!("{label}.radius"), o.radius.unwrap())?;
+                Shape::sphere(get(o.center, "center")?, radius)
+            }
+            ObjectType::Plane => {
+                let normal = self.direction(span.clone(), &format!("{label}.normal"), o.normal.unwrap().0)?;
+                Shape::plane(get(o.point, "point")?, normal)
+            }
+            ObjectType::Quad => {
+                let (u, v) = (get(o.edge_u, "edge_u")?, get(o.edge_v, "edge_v")?);
+                self.edges(span.clone(), &label, u, v)?;
+                Shape::quad(get(o.corner, "corner")?, u, v)
+            }
+            ObjectType::Box => {
+                let (min, max) = (get(o.min, "min")?, get(o.max, "max")?);
+                if !min.cmplt(max).all() {
+                    return Err(self.err_field(
+                        span,
+                        "max",
+                        format!("{label}: min must be less than max on every axis, got min {min} max {max}"),
+                    ));
+                }
+                Shape::cuboid(min, max)
+            }
+            ObjectType::Mesh => self.mesh(&label, o.file.as_ref().unwrap())?,
+            ObjectType::Sdf => Shape::Sdf(self.sdf_object(span.clone(), &label, o)?),
+        };
+        let transform = self.transform(span.clone(), &label, o)?;
+        if let Some(emission) = o.emission {
+            let radiance = self.non_negative3(span.clone(), &format!("{label}.emission"), emission.0)?;
+            if let Some(material) = &o.material {
+                return Err(self.err(
+                    material.span(),
+                    format!("{label}: an emitting object's surface is black and reflects nothing; drop its `material`"),
+                ));
+            }
+            let placed = self.placed(span.clone(), &label, shape.transformed(transform))?;
+            let lights = self.emitter(span, &label, placed, radiance)?;
+            return Ok(Built { lights, ..Built::default() });
+        }
+        let material = match &o.material {
+            Some(name) => {
+                if !scene.materials.contains_key(name.get_ref()) {
+                    let known: Vec<&str> = scene.materials.keys().map(String::as_str).collect();
+                    return Err(self.err(
+                        name.span(),
+                        format!("{label}: unknown material `{}`; the scene defines: {}", name.get_ref(), list(&known)),
+                    ));
+                }
+                name.get_ref().clone()
+            }
+            None => {
+                return Err(self.err(span, format!("{label} needs a `material` (a name from [materials])")));
+            }
+        };
+        let objects = vec![(self.placed(span, &label, shape.transformed(transform))?, material)];
+        Ok(Built { objects, ..Built::default() })
+    }
+
+    /// One `[[include]]`: a glTF file, or an OBJ file as a mesh object
+    /// would take it.
+    pub(super) fn include(
+        &self,
+        index: usize,
+        desc: &Spanned<IncludeDesc>,
+        scene: &SceneDesc,
+    ) -> Result<gltf::Imported> {
+        let span = desc.span();
+        let d = desc.get_ref();
+        let label = format!("include[{index}]");
+        let transform = self.transform_parts(span.clone(), &label, d.translate, d.rotate, d.scale)?;
+        if let Some(name) = &d.material
+            && !scene.materials.contains_key(name.get_ref())
+        {
+            let known: Vec<&str> = scene.materials.keys().map(String::as_str).collect();
+            return Err(self.err(
+                name.span(),
+                format!("{label}: unknown material `{}`; the scene defines: {}", name.get_ref(), list(&known)),
+            ));
+        }
+        let material = d.material.as_ref().map(|m| m.get_ref().as_str());
+        let file = d.file.get_ref().to_ascii_lowercase();
+        if file.ends_with(".obj") {
+            if d.scene.is_some() {
+                return Err(self.err_field(span, "scene", format!("{label}: `scene` is for glTF files")));
+            }
+            let built = match material {
+                Some(name) => {
+                    let shape = self.placed(span, &label, self.mesh(&label, &d.file)?.transformed(transform))?;
+                    Built { objects: vec![(shape, name.to_string())], ..Built::default() }
+                }
+                None => self.mesh_with_materials(span, &label, &d.file, transform)?,
+            };
+            return Ok(gltf::Imported { built, camera: None });
+        }
+        if !(file.ends_with(".gltf") || file.ends_with(".glb")) {
+            return Err(self.err(d.file.span(), format!("{label}: `file` must be a .gltf, .glb or .obj file")));
+        }
+        self.gltf(&gltf::Include { label: &label, file: &d.file, scene: d.scene.as_deref(), transform, material })
+    }
+
+    /// A mesh object without a `material`: its faces take the `.mtl`
+    /// materials their `usemtl` names, `Kd` as a diffuse albedo (0.8 when
+    /// absent), and faces whose material has a `Ke` emit it.
+    fn mesh_with_materials(
+        &self,
+        span: Range<usize>,
+        label: &str,
+        file: &Spanned<String>,
+        transform: Affine3A,
+    ) -> Result<Built> {
+        let parts = self.mesh_parts(label, file)?;
+        let only_part = parts.len() == 1;
+        let mut built = Built::default();
+        for part in parts {
+            let texture = part.texture;
+            let Some(m) = part.material else {
+                let why = if only_part {
+                    "(a name from [materials]), or faces with `usemtl` materials from an `mtllib`"
+                } else {
+                    "for its faces before the first `usemtl`"
+                };
+                return Err(self.err(span, format!("{label} needs a `material` {why}")));
+            };
+            let placed = self.placed(span.clone(), label, part.shape.transformed(transform))?;
+            match m.emission {
+                Some(radiance) if radiance.max_element() > 0.0 => {
+                    built.lights.extend(self.emitter(span.clone(), label, placed, radiance)?)
+                }
+                _ => {
+                    let name = format!("{}:{}", file.get_ref(), m.name);
+                    let material = match texture {
+                        // The MTL convention: the map scaled by Kd (1 when absent).
+                        Some(t) => Material::textured(m.diffuse.unwrap_or(Vec3::ONE), t),
+                        None => Material::diffuse(m.diffuse.unwrap_or(Vec3::splat(0.8))),
+                    };
+                    built.materials.push((name.clone(), material));
+                    built.objects.push((placed, name));
+                }
+            }
+        }
+        Ok(built)
+    }
+
+    /// The lights an emitting object becomes: a sphere light, a quad light,
+    /// or a triangle light per triangle of a mesh (degenerate triangles,
+    /// which emit nothing, are left out).
+    fn emitter(&self, span: Range<usize>, label: &str, shape: Shape, radiance: Rgb) -> Result<Vec<Light>> {
+        match shape {
+            Shape::Sphere { center, radius } => Ok(vec![Light::sphere(center, radius, radiance)]),
+            Shape::Quad { corner, edge_u, edge_v } => Ok(vec![Light::quad(corner, edge_u, edge_v, radiance)]),
+            // The mesh's memory was checked when it was read.
+            Shape::Mesh { positions, triangles, .. } => Ok(Light::triangles_of(&positions, &triangles, radiance)),
+            _ => Err(self.err_field(
+                span,
+                "emission",
+                format!(
+                    "{label}: only sphere, quad and mesh objects can emit (a sphere stretched by `scale` \
+                     cannot either)"
+                ),
+            )),
+        }
+    }
+
+    /// A shape in world space, checked for what its transform may have
+    /// pushed out of f32's range: too far, edges or a normal lost.
+    fn placed(&self, span: Range<usize>, label: &str, shape: Shape) -> Result<Shape> {
+        let extent = limits::shape_extent(&shape);
+        // Never NaN: a shape with a non-finite point reaches infinity.
+        if extent > limits::MAX_COORDINATE {
+            return Err(self.err(span, limits::too_far(label, extent)));
+        }
+        match &shape {
+            Shape::Quad { edge_u, edge_v, .. } => self.edges(span, label, *edge_u, *edge_v)?,
+            Shape::Plane { normal, .. } if !normal.is_normalized() => {
+                return Err(self.err_field(span, "scale", format!("{label}: its scale leaves the plane no normal")));
+            }
+            Shape::Transformed { world_from_local, .. } if !world_from_local.inverse().is_finite() => {
+                return Err(self.err_field(span, "scale", format!("{label}: its scale is too small to invert")));
+            }
+            _ => {}
+        }
+        Ok(shape)
+    }
+
+    /// Checks that an object or light has every field its type needs and
+    /// none that belongs to another type.
+    pub(super) fn check_fields(
+        &self,
+        span: Range<usize>,
+        label: &str,
+        kind: &str,
+        fields: &[(&str, bool)],
+        required: &[&str],
+        optional: &[&str],
+    ) -> Result<()> {
+        for (name, present) in fields {
+            if *present && !required.contains(name) && !optional.contains(name) {
+                let takes = [required, optional].concat();
+                return Err(self.err_field(
+                    span,
+                    name,
+                    format!("{label}: `{name}` does not belong to a {kind}, which takes {}", list(&takes)),
+                ));
+            }
+        }
+        for name in required {
+            if !fields.iter().any(|(n, present)| n == name && *present) {
+                return Err(self.err(span, format!("{label}: a {kind} needs `{name}`")));
+            }
+        }
+        Ok(())
+    }
+
+    /// T·Rz·Ry·Rx·S: scale, then rotate about X, Y, Z (degrees), then translate.
+    fn transform(&self, span: Range<usize>, label: &str, o: &ObjectDesc) -> Result<Affine3A> {
+        self.transform_parts(span, label, o.translate, o.rotate, o.scale)
+    }
+
+    /// The transform of `translate`, `rotate` (degrees) and `scale`, each optional.
+    pub(super) fn transform_parts(
+        &self,
+        span: Range<usize>,
+        label: &str,
+        translate: Option<Point>,
+        rotate: Option<Point>,
+        scale: Option<Triple>,
+    ) -> Result<Affine3A> {
+        let translate =
+            self.finite3(span.clone(), &format!("{label}.translate"), translate.map_or(Vec3::ZERO, |p| p.0))?;
+        let rotate = self.finite3(span.clone(), &format!("{label}.rotate"), rotate.map_or(Vec3::ZERO, |p| p.0))?;
+        let scale = self.finite3(span.clone(), &format!("{label}.scale"), scale.map_or(Vec3::ONE, |p| p.0))?;
+        if scale.cmpeq(Vec3::ZERO).any() {
+            return Err(self.err_field(
+                span,
+                "scale",
+                format!("{label}.scale must not be zero on any axis, got {scale}"),
+            ));
+        }
+        let r = rotate * (std::f32::consts::PI / 180.0);
+        let rotation = Quat::from_rotation_z(r.z) * Quat::from_rotation_y(r.y) * Quat::from_rotation_x(r.x);
+        Ok(Affine3A::from_scale_rotation_translation(scale, rotation, translate))
+    }
+}
+
+/// Names as a list for a message: `a`, `b`, `c`.
+fn list(names: &[&str]) -> String {
+    if names.is_empty() {
+        return "(none)".into();
+    }
+    names.iter().map(|n| format!("`{n}`")).collect::<Vec<_>>().join(", ")
+}
