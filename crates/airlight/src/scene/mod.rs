@@ -15,6 +15,7 @@ mod build_lights;
 mod build_materials;
 mod build_medium;
 mod build_objects;
+mod builder;
 pub mod desc;
 mod emitters;
 mod error;
@@ -33,6 +34,7 @@ mod warnings;
 pub use assets::AssetPath;
 pub use build::{build, parse};
 pub use build_materials::medium_from_options;
+pub use builder::SceneBuilder;
 pub use desc::SceneDesc;
 pub use error::{SceneError, line_col};
 pub use lights::LightCulling;
@@ -45,8 +47,7 @@ use crate::light::{Keyframes, Light};
 use crate::material::Material;
 use crate::medium::Medium;
 use emitters::Emitters;
-use glam::{Affine3A, Vec3};
-use std::collections::HashMap;
+use glam::Vec3;
 
 /// The film and sampling settings of `[render]`: what every integrator
 /// shares. Integrators' own options live in [`crate::integrator`].
@@ -394,123 +395,6 @@ fn build_geometry(surfaces: impl Iterator<Item = Surface>) -> Geometry {
         geometry.add(&s.shape, s.material, s.emitter);
     }
     geometry.build()
-}
-
-/// Builds a [`Scene`] in Rust, as a World/Camera example in a tutorial would.
-#[derive(Default)]
-pub struct SceneBuilder {
-    settings: RenderSettings,
-    camera: Option<Camera>,
-    materials: Vec<Material>,
-    material_names: HashMap<String, u32>,
-    objects: Vec<(Shape, String)>,
-    lights: Vec<Light>,
-    light_paths: Vec<Option<Keyframes>>,
-    medium: Option<Medium>,
-}
-
-impl SceneBuilder {
-    pub fn new() -> Self {
-        Self::default()
-    }
-
-    pub fn size(mut self, width: u32, height: u32) -> Self {
-        self.settings.width = width;
-        self.settings.height = height;
-        self
-    }
-
-    pub fn settings(mut self, settings: RenderSettings) -> Self {
-        self.settings = settings;
-        self
-    }
-
-    /// Changes the settings in place.
-    pub fn with_settings(mut self, change: impl FnOnce(&mut RenderSettings)) -> Self {
-        change(&mut self.settings);
-        self
-    }
-
-    pub fn camera(mut self, camera: Camera) -> Self {
-        self.camera = Some(camera);
-        self
-    }
-
-    /// Names a material; a later one of the same name replaces it.
-    pub fn material(mut self, name: &str, material: Material) -> Self {
-        match self.material_names.get(name) {
-            Some(&i) => self.materials[i as usize] = material,
-            None => {
-                self.material_names.insert(name.to_string(), self.materials.len() as u32);
-                self.materials.push(material);
-            }
-        }
-        self
-    }
-
-    pub fn object(mut self, shape: Shape, material: &str) -> Self {
-        self.objects.push((shape, material.to_string()));
-        self
-    }
-
-    pub fn object_transformed(self, shape: Shape, transform: Affine3A, material: &str) -> Self {
-        self.object(shape.transformed(transform), material)
-    }
-
-    pub fn light(mut self, light: Light) -> Self {
-        self.lights.push(light);
-        self.light_paths.push(None);
-        self
-    }
-
-    /// A light that moves along `path` in animations.
-    pub fn moving_light(mut self, light: Light, path: Keyframes) -> Self {
-        self.lights.push(light);
-        self.light_paths.push(Some(path));
-        self
-    }
-
-    pub fn medium(mut self, medium: Medium) -> Self {
-        self.medium = Some(medium);
-        self
-    }
-
-    /// Checks and builds the scene, with its BVH.
-    pub fn build(self) -> Result<Scene, SceneError> {
-        let SceneBuilder { settings, camera, materials, material_names, objects, lights, light_paths, medium } = self;
-        settings.validate().map_err(SceneError::new)?;
-        let camera = camera.unwrap_or_else(default_camera);
-        let mut placed = Vec::with_capacity(objects.len());
-        for (shape, name) in objects {
-            let Some(&material) = material_names.get(&name) else {
-                return Err(SceneError::new(format!("unknown material `{name}`")));
-            };
-            placed.push((shape, material));
-        }
-        let emitters = Emitters::new(&lights);
-        let light_culling = LightCulling::new(&lights, emitters.firsts());
-        let placed_delta = placed_delta(&lights);
-        let mut scene = Scene {
-            settings,
-            camera,
-            materials,
-            lights,
-            light_paths,
-            medium: medium.filter(|m| !m.is_vacuum()),
-            objects: placed,
-            geometry: Geometry::default(),
-            bounds_center: Vec3::ZERO,
-            bounds_radius: 1.0,
-            light_culling,
-            emitters,
-            placed_delta,
-            files: Vec::new(),
-            notes: Vec::new(),
-        };
-        scene.geometry = build_geometry(scene.surfaces());
-        scene.update_bounds();
-        Ok(scene)
-    }
 }
 
 /// The camera of a scene that names none.
