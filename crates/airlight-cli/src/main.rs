@@ -163,6 +163,13 @@ fn load(path: Option<&Path>) -> Result<SceneFile, String> {
     }
 }
 
+/// Sets `slot` to the command line's value where the option was given.
+fn set_given<T>(slot: &mut T, given: Option<T>) {
+    if let Some(value) = given {
+        *slot = value;
+    }
+}
+
 fn gi(args: GiArgs) -> Result<(), String> {
     use airlight::integrator::{Integrator, RadiosityIntegrator};
     use airlight::render::{frame_time, render, set_time};
@@ -171,23 +178,13 @@ fn gi(args: GiArgs) -> Result<(), String> {
     if let Some(v) = args.patch_size {
         options.patch_size = Some(v);
     }
-    if let Some(v) = args.link_threshold {
-        options.link_threshold = v;
-    }
-    if let Some(v) = args.bounces {
-        options.bounces = v;
-    }
+    set_given(&mut options.link_threshold, args.link_threshold);
+    set_given(&mut options.bounces, args.bounces);
     desc.validate().map_err(|e| format!("--{}", e.to_string().replace('_', "-")))?;
     let s = scene.settings_mut();
-    if let Some(v) = args.spp {
-        s.spp = v;
-    }
-    if let Some(v) = args.width {
-        s.width = v;
-    }
-    if let Some(v) = args.height {
-        s.height = v;
-    }
+    set_given(&mut s.spp, args.spp);
+    set_given(&mut s.width, args.width);
+    set_given(&mut s.height, args.height);
     s.validate()?;
     if let Some(dir) = &args.output_dir {
         outputs::check_folder("--output-dir", dir)?;

@@ -1,7 +1,7 @@
 //! What `airlight render`'s command line says: its arguments, checked as
 //! clap parses them, and the scene file with their overrides applied.
 
-use crate::load;
+use crate::{load, set_given};
 use airlight::SceneFile;
 use airlight::integrator::analytic::LightQuadrature;
 use airlight::integrator::{IntegratorKind, MAX_LIGHT_STEPS, MAX_STEPS, Sampling};
@@ -120,32 +120,18 @@ pub struct RenderArgs {
 pub(super) fn configure(args: &RenderArgs) -> Result<SceneFile, String> {
     let mut file = load(args.scene.as_deref())?;
     let s = file.scene.settings_mut();
-    if let Some(v) = args.spp {
-        s.spp = v;
-    }
-    if let Some(v) = args.width {
-        s.width = v;
-    }
-    if let Some(v) = args.height {
-        s.height = v;
-    }
-    if let Some(v) = args.seed {
-        s.seed = v;
-    }
+    set_given(&mut s.spp, args.spp);
+    set_given(&mut s.width, args.width);
+    set_given(&mut s.height, args.height);
+    set_given(&mut s.seed, args.seed);
     if args.adaptive {
         s.adaptive = true;
     }
     s.validate()?;
     let d = &mut file.integrator;
-    if let Some(v) = args.integrator {
-        d.kind = v;
-    }
-    if let Some(v) = args.steps {
-        d.raymarch.steps = v;
-    }
-    if let Some(v) = args.sampling {
-        d.stochastic.sampling = v;
-    }
+    set_given(&mut d.kind, args.integrator);
+    set_given(&mut d.raymarch.steps, args.steps);
+    set_given(&mut d.stochastic.sampling, args.sampling);
     if args.reuse {
         d.path.reuse = true;
     }
@@ -155,12 +141,8 @@ pub(super) fn configure(args: &RenderArgs) -> Result<SceneFile, String> {
     if args.shadows {
         d.analytic.shadows = true;
     }
-    if let Some(v) = args.light_steps {
-        d.analytic.light_steps = v;
-    }
-    if let Some(v) = args.light_quadrature {
-        d.analytic.quadrature = v;
-    }
+    set_given(&mut d.analytic.light_steps, args.light_steps);
+    set_given(&mut d.analytic.quadrature, args.light_quadrature);
     d.validate().map_err(|e| format!("--{}", e.to_string().replace('_', "-")))?;
     if let Some(model) = args.attenuation {
         file.scene.set_attenuation_model(model).map_err(|e| format!("--attenuation: {e}"))?;
