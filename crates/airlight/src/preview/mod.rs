@@ -80,11 +80,18 @@ impl<'a> Preview<'a> {
     }
 }
 
+/// The glow of `scene`'s medium: in closed form where each light is one
+/// point to it (point, spot and sphere lights in homogeneous fog), else
+/// marched. A line, quad or mesh light is a sum of `light_steps` or its
+/// square of closed forms a ray, more where a ray passes close: a frame of
+/// a room lit by an emitting quad in fog took minutes so, where the march
+/// takes a fraction of a second, its noise averaging away as the view
+/// refines.
 fn glow(scene: &Scene, options: AnalyticOptions, march: RaymarchOptions) -> Glow {
     match scene.medium() {
         Some(m) if m.sigma_s != Rgb::ZERO => match Analytic::new(scene, options) {
-            Ok(a) => Glow::Analytic(Box::new(a)),
-            Err(_) => Glow::March(march),
+            Ok(a) if a.lights_are_points() => Glow::Analytic(Box::new(a)),
+            _ => Glow::March(march),
         },
         _ => Glow::None,
     }

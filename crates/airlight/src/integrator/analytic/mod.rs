@@ -355,6 +355,16 @@ impl Analytic {
         Ok(Analytic { options, emitters, extended, rule, sphere_rule, blockers, meshes })
     }
 
+    /// Whether every light is one point to a ray (point and spot lights,
+    /// and sphere lights seen as their centres): the glow then costs a ray
+    /// one closed form a light. A line, quad or triangle light (each of an
+    /// emitting mesh's triangles is one), or a sphere light near a surface
+    /// with shadows, is a sum of `light_steps` or its square of them, and
+    /// more where a ray passes close and a piece is split.
+    pub fn lights_are_points(&self) -> bool {
+        self.extended.iter().all(|x| matches!(x, Extended::Sphere { near_surface: false, .. }))
+    }
+
     /// Single-scattered radiance along `ray` over [0, t_end] from all lights.
     /// The scene's occluders were prepared by [`Analytic::new`]; `_scene` is
     /// kept for the callers' sake (the other integrators' signature).
