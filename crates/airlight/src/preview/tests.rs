@@ -44,7 +44,7 @@ fn without_a_medium_the_preview_is_the_radiosity_integrator() {
 fn in_a_homogeneous_medium_a_point_light_glows_in_closed_form_and_adds_light() {
     let fog = Medium::homogeneous(Rgb::ZERO, Rgb::splat(0.05), 0.0);
     let lamp = Light::point(vec3(0.0, 2.5, 0.0), Rgb::splat(20.0));
-    let scene = room_lit_by(lamp.clone(), Some(fog));
+    let scene = room_lit_by(lamp, Some(fog));
     let foggy_preview = preview(&scene, None);
     assert_eq!(foggy_preview.glow_name(), "analytic glow");
     let foggy = crate::render::render(&scene, &foggy_preview, &RenderObserver::none());
