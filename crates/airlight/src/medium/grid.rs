@@ -188,16 +188,27 @@ impl DensityGrid {
         }
         let u = v - 0.5;
         let base = u.floor();
-        let f = u - base;
-        let clamp = |x: f32, axis: usize| (x.max(0.0) as usize).min(self.resolution[axis] - 1);
-        let (i0, j0, k0) = (clamp(base.x, 0), clamp(base.y, 1), clamp(base.z, 2));
-        let (i1, j1, k1) = (clamp(base.x + 1.0, 0), clamp(base.y + 1.0, 1), clamp(base.z + 1.0, 2));
-        let lerp = |a: f32, b: f32, t: f32| a + (b - a) * t;
-        let x00 = lerp(self.value(i0, j0, k0), self.value(i1, j0, k0), f.x);
-        let x10 = lerp(self.value(i0, j1, k0), self.value(i1, j1, k0), f.x);
-        let x01 = lerp(self.value(i0, j0, k1), self.value(i1, j0, k1), f.x);
-        let x11 = lerp(self.value(i0, j1, k1), self.value(i1, j1, k1), f.x);
-        lerp(lerp(x00, x10, f.y), lerp(x01, x11, f.y), f.z)
+        trilinear(&self.cell_values(base.as_ivec3()), u - base)
+    }
+
+    /// The values at the eight corners of cell `c` of the interpolant (the
+    /// cell whose low corner is the centre of voxel `c`), clamped to the
+    /// grid at its faces, x fastest.
+    #[inline]
+    fn cell_values(&self, c: IVec3) -> [f32; 8] {
+        let clamp = |x: i32, axis: usize| (x.max(0) as usize).min(self.resolution[axis] - 1);
+        let (i0, j0, k0) = (clamp(c.x, 0), clamp(c.y, 1), clamp(c.z, 2));
+        let (i1, j1, k1) = (clamp(c.x + 1, 0), clamp(c.y + 1, 1), clamp(c.z + 1, 2));
+        [
+            self.value(i0, j0, k0),
+            self.value(i1, j0, k0),
+            self.value(i0, j1, k0),
+            self.value(i1, j1, k0),
+            self.value(i0, j0, k1),
+            self.value(i1, j0, k1),
+            self.value(i0, j1, k1),
+            self.value(i1, j1, k1),
+        ]
     }
 
     /// The part of [t0, t1] of the line o + t·d inside the box, if any.
@@ -218,9 +229,11 @@ impl DensityGrid {
         // Gauss–Legendre, two points: ±1/√3 about the middle.
         const NODE: f64 = 0.577_350_269_189_625_8;
         let mut sum = 0.0f64;
-        walk(vo, vd, a, b, Vec3::ONE, Vec3::splat(0.5), |s0, s1, _| {
+        walk(vo, vd, a, b, Vec3::ONE, Vec3::splat(0.5), |s0, s1, cell| {
             let (mid, half) = (0.5 * (s0 as f64 + s1 as f64), 0.5 * (s1 as f64 - s0 as f64));
-            let at = |t: f64| self.density_voxel(vo + vd * t as f32) as f64;
+            // Both points lie in `cell`: its corners are read once.
+            let (corners, low) = (self.cell_values(cell), cell.as_vec3());
+            let at = |t: f64| trilinear(&corners, (vo + vd * t as f32 - 0.5) - low) as f64;
             sum += half * (at(mid - half * NODE) + at(mid + half * NODE));
             true
         });
@@ -241,6 +254,17 @@ impl DensityGrid {
             f(s0, s1, bound)
         });
     }
+}
+
+/// The trilinear interpolation of a cell's `corners` (x fastest) at
+/// offset `f` from its low corner.
+#[inline]
+fn trilinear(corners: &[f32; 8], f: Vec3) -> f32 {
+    let lerp = |a: f32, b: f32, t: f32| a + (b - a) * t;
+    let [c000, c100, c010, c110, c001, c101, c011, c111] = *corners;
+    let (x00, x10) = (lerp(c000, c100, f.x), lerp(c010, c110, f.x));
+    let (x01, x11) = (lerp(c001, c101, f.x), lerp(c011, c111, f.x));
+    lerp(lerp(x00, x10, f.y), lerp(x01, x11, f.y), f.z)
 }
 
 /// The part of [t0, t1] of o + t·d inside the box [0, n], by slabs.
