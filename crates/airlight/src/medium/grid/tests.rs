@@ -51,6 +51,48 @@ fn values_sit_at_voxel_centres_and_are_clamped_to_the_box() {
     assert_eq!(g.density(Vec3::new(1.5, 1.5, 0.5)), 0.0);
 }
 
+/// A multilinear function of the voxel coordinates, which the trilinear
+/// interpolant of its values at the centres reproduces exactly: every
+/// corner of a cell weighs in, so a corner read in the wrong place shows.
+fn multilinear(x: f64, y: f64, z: f64) -> f64 {
+    1.0 + 2.0 * x + 3.0 * y + 5.0 * z + 7.0 * x * y + 11.0 * y * z + 13.0 * x * z + 17.0 * x * y * z
+}
+
+#[test]
+fn density_and_its_integral_reproduce_a_multilinear_function_between_centres() {
+    // Two voxels a side, centres at 0.5 and 1.5: one whole cell between them.
+    let mut values = Vec::new();
+    for k in 0..2 {
+        for j in 0..2 {
+            for i in 0..2 {
+                values.push(multilinear(i as f64, j as f64, k as f64) as f32);
+            }
+        }
+    }
+    let g = grid([2, 2, 2], values, 1.0);
+    let mut s = Sampler::for_pixel(4, 0, 0);
+    for _ in 0..200 {
+        let u = Vec3::new(s.next(), s.next(), s.next());
+        let expected = multilinear(u.x as f64, u.y as f64, u.z as f64);
+        let got = g.density(u + 0.5) as f64;
+        assert!((got - expected).abs() < 1e-5 * expected, "at {u}: {got} against {expected}");
+    }
+    // Chords of the cell between the centres, against Simpson on the
+    // function itself.
+    for _ in 0..40 {
+        let (a, b) = (Vec3::new(s.next(), s.next(), s.next()), Vec3::new(s.next(), s.next(), s.next()));
+        let (length, d) = ((b - a).length(), (b - a).normalize());
+        let o = a + 0.5;
+        let exact = g.integral(o, d, 0.0, length);
+        let on_chord = |t: f64| {
+            let q = a.as_dvec3() + d.as_dvec3() * t;
+            multilinear(q.x, q.y, q.z)
+        };
+        let numeric = simpson(on_chord, 0.0, length as f64, 2_000);
+        assert!((exact - numeric).abs() < 1e-5 * numeric.max(1.0), "{exact} against {numeric}");
+    }
+}
+
 #[test]
 fn the_integral_of_two_constant_halves_is_the_hand_computed_one() {
     // 8 voxels of size 0.25 along x: 4 of a, 4 of b. Across the whole box
