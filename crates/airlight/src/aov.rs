@@ -11,6 +11,7 @@
 use crate::Rgb;
 use crate::film::Image;
 use crate::integrator::Integrator;
+use crate::render::PixelSample;
 use crate::scene::Scene;
 use glam::Vec3;
 use rayon::prelude::*;
@@ -117,9 +118,7 @@ pub fn surface_aovs(scene: &Scene, stratified: bool, samples: Range<u64>) -> Sur
             let (x, y) = ((index % width as usize) as u32, (index / width as usize) as u32);
             let (mut albedo, mut normal, mut depth, mut hits) = (Rgb::ZERO, Vec3::ZERO, 0.0f64, 0u64);
             for i in samples.clone() {
-                let index = y as u64 * width as u64 + x as u64;
-                let mut sampler = crate::sampling::Sampler::for_pixel(s.seed, index, i);
-                let ray = crate::render::camera_ray(scene, stratified, x, y, &mut sampler);
+                let ray = PixelSample::new(s, s.seed, stratified, x, y, i).ray(scene);
                 let Some(hit) = scene.geometry().intersect(&ray, f32::INFINITY) else { continue };
                 let surface = scene.geometry().surface(&ray, hit);
                 if surface.emitter.is_none() {
@@ -159,9 +158,9 @@ pub fn in_scattered_aov(scene: &Scene, integrator: &dyn Integrator, samples: Ran
             // the same mean, bit for bit.
             let mut sum = crate::film::PixelSum::default();
             for i in samples.clone() {
-                let mut sampler = crate::sampling::Sampler::for_pixel(s.seed, index as u64, i);
-                let ray = crate::render::camera_ray(scene, stratified, x, y, &mut sampler);
-                sum.add(integrator.radiance_parts(scene, &ray, &mut sampler)?.in_scattered);
+                let mut sample = PixelSample::new(s, s.seed, stratified, x, y, i);
+                let ray = sample.ray(scene);
+                sum.add(integrator.radiance_parts(scene, &ray, &mut sample.sampler)?.in_scattered);
             }
             Some(sum.mean())
         })
@@ -232,10 +231,23 @@ mod tests {
     }
 
     fn single_scattering(scene: &Scene) -> Vec<(IntegratorKind, Box<dyn Integrator>)> {
-        [IntegratorKind::Raymarch, IntegratorKind::Analytic, IntegratorKind::Stochastic]
+        IntegratorKind::ALL
             .into_iter()
+            .filter(|k| k.separates_in_scattering())
             .map(|kind| (kind, IntegratorDesc::new(kind).build(scene).unwrap()))
             .collect()
+    }
+
+    #[test]
+    fn each_kind_says_whether_its_integrator_separates_the_medium_light() {
+        let scene = foggy(true, true);
+        let ray = crate::geometry::Ray::new(Vec3::new(0.0, 1.0, -4.0), Vec3::Z);
+        for kind in IntegratorKind::ALL {
+            let integrator = IntegratorDesc::new(kind).build(&scene).unwrap();
+            let mut sampler = crate::sampling::Sampler::for_pixel(1, 2, 3);
+            let parts = integrator.radiance_parts(&scene, &ray, &mut sampler);
+            assert_eq!(parts.is_some(), kind.separates_in_scattering(), "{kind}");
+        }
     }
 
     #[test]
@@ -283,9 +295,10 @@ mod tests {
                 let (x, y) = (i as u32 % 6, i as u32 / 6);
                 let mut surface = glam::DVec3::ZERO;
                 for k in samples.clone() {
-                    let mut sampler = crate::sampling::Sampler::for_pixel(scene.settings().seed, i as u64, k);
-                    let ray = crate::render::camera_ray(&scene, integrator.stratified(), x, y, &mut sampler);
-                    surface += integrator.radiance_parts(&scene, &ray, &mut sampler).unwrap().surface.as_dvec3();
+                    let s = scene.settings();
+                    let mut sample = PixelSample::new(s, s.seed, integrator.stratified(), x, y, k);
+                    let ray = sample.ray(&scene);
+                    surface += integrator.radiance_parts(&scene, &ray, &mut sample.sampler).unwrap().surface.as_dvec3();
                 }
                 let surface = (surface / samples.end as f64).as_vec3();
                 floor_seen |= surface.x > 0.0;

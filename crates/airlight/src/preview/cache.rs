@@ -19,7 +19,7 @@ use crate::film::Image;
 use crate::geometry::{Geometry, GeometryBuilder, Hit, Ray, SurfaceHit};
 use crate::integrator::{DeferredShadows, through_medium};
 use crate::radiosity::Radiosity;
-use crate::render::film_sample;
+use crate::render::PixelSample;
 use crate::sampling::Sampler;
 use crate::scene::{PixelFilter, Scene};
 use crate::scratch::with_scratch;
@@ -236,10 +236,10 @@ pub(super) fn trace_texels(
     films.clear();
     lenses.clear();
     for (texel, x) in out.iter_mut().zip(span.columns(w)) {
-        texel.sampler = Sampler::for_pixel(s.seed, (y * w + x) as u64, 0);
-        let (film, lens) = film_sample(s.filter, false, x as u32, y as u32, &mut texel.sampler);
-        films.push(film);
-        lenses.push(lens);
+        let sample = PixelSample::new(s, s.seed, false, x as u32, y as u32, 0);
+        texel.sampler = sample.sampler;
+        films.push(sample.film);
+        lenses.push(sample.lens);
     }
     rays.clear();
     camera.rays_into(films, lenses, rays);

@@ -16,9 +16,8 @@ use std::sync::atomic::{AtomicBool, Ordering};
 pub mod adaptive;
 mod samples;
 
-pub(crate) use samples::film_sample;
 use samples::tile_sums;
-pub use samples::{BLOCK, BLOCK_ORDER, camera_ray, pixel_sum};
+pub use samples::{BLOCK, BLOCK_ORDER, PixelSample, pixel_sum};
 
 const TILE: u32 = 16;
 

@@ -7,7 +7,7 @@ use crate::Rgb;
 use crate::film::{AddSample, PixelSum};
 use crate::integrator::Integrator;
 use crate::sampling::Sampler;
-use crate::scene::{PixelFilter, Scene};
+use crate::scene::{PixelFilter, RenderSettings, Scene};
 use glam::Vec2;
 use std::ops::Range;
 
@@ -88,11 +88,10 @@ pub(super) fn tile_sums(
             let end = block.iter().map(|(.., r)| r.end).max().unwrap_or(0);
             for i in first..end {
                 for (x, y, _) in block.iter().filter(|(.., r)| r.contains(&i)) {
-                    let mut sampler = Sampler::for_pixel(seed, *y as u64 * s.width as u64 + *x as u64, i);
-                    let (point, lens) = film_sample(s.filter, integrator.stratified(), *x, *y, &mut sampler);
-                    batch.films.push(point);
-                    batch.lenses.push(lens);
-                    batch.samplers.push(sampler);
+                    let sample = PixelSample::new(s, seed, integrator.stratified(), *x, *y, i);
+                    batch.films.push(sample.film);
+                    batch.lenses.push(sample.lens);
+                    batch.samplers.push(sample.sampler);
                     batch.pixels.push((*x, *y));
                     if batch.pixels.len() == n {
                         trace(&mut batch);
@@ -147,46 +146,50 @@ impl Batch {
 /// lens samples, and differ only by what the integrators compute.
 pub fn pixel_sum(scene: &Scene, integrator: &dyn Integrator, x: u32, y: u32, samples: Range<u64>) -> PixelSum {
     let s = scene.settings();
-    let index = y as u64 * s.width as u64 + x as u64;
     let mut sum = PixelSum::default();
     for i in samples {
-        let mut sampler = Sampler::for_pixel(s.seed, index, i);
-        let ray = camera_ray(scene, integrator.stratified(), x, y, &mut sampler);
-        sum.add(integrator.radiance(scene, &ray, &mut sampler));
+        let mut sample = PixelSample::new(s, s.seed, integrator.stratified(), x, y, i);
+        let ray = sample.ray(scene);
+        sum.add(integrator.radiance(scene, &ray, &mut sample.sampler));
     }
     sum
 }
 
-/// The camera ray of a sample of pixel (x, y), drawn from the sample's
-/// `sampler` first (its anti-aliasing and lens numbers; from the pixel's
-/// stratified sequence when `stratified`, see
-/// [`Integrator::stratified`]), so that the AOVs ([`crate::aov`]) trace
-/// exactly the render's rays.
-pub fn camera_ray(scene: &Scene, stratified: bool, x: u32, y: u32, sampler: &mut Sampler) -> crate::geometry::Ray {
-    let s = scene.settings();
-    let (point, lens) = film_sample(s.filter, stratified, x, y, sampler);
-    scene.camera().rays(s.width, s.height).ray(point, lens)
+/// Sample `i` of pixel (x, y): its random stream, keyed by (seed, pixel,
+/// sample number), and the film and lens points of its camera ray, drawn
+/// from that stream first (from the pixel's stratified sequence when
+/// `stratified`, see [`Integrator::stratified`]). The one place a pixel
+/// sample is made: tiles, AOVs and the viewer's preview all draw theirs
+/// here, so that they trace the same rays with the same numbers.
+pub struct PixelSample {
+    /// The stream the integrator goes on drawing from.
+    pub sampler: Sampler,
+    /// The point on the film, in pixels from the image's top-left corner.
+    pub film: Vec2,
+    /// The point on the lens, in [0, 1)².
+    pub lens: Vec2,
 }
 
-/// The film point in pixel (x, y) and the lens point of a sample's camera
-/// ray, drawn from its `sampler` as [`camera_ray`] draws them.
-pub(crate) fn film_sample(
-    filter: PixelFilter,
-    stratified: bool,
-    x: u32,
-    y: u32,
-    sampler: &mut Sampler,
-) -> (Vec2, Vec2) {
-    let (jitter, lens) = if stratified {
-        let u = sampler.stratified4(0);
-        (Vec2::new(u[0], u[1]), Vec2::new(u[2], u[3]))
-    } else {
-        (sampler.next2(), sampler.next2())
-    };
-    let point = Vec2::new(x as f32, y as f32)
-        + match filter {
-            PixelFilter::Box => jitter,
-            PixelFilter::Point => Vec2::splat(0.5),
+impl PixelSample {
+    pub fn new(settings: &RenderSettings, seed: u64, stratified: bool, x: u32, y: u32, i: u64) -> PixelSample {
+        let mut sampler = Sampler::for_pixel(seed, y as u64 * settings.width as u64 + x as u64, i);
+        let (jitter, lens) = if stratified {
+            let u = sampler.stratified4(0);
+            (Vec2::new(u[0], u[1]), Vec2::new(u[2], u[3]))
+        } else {
+            (sampler.next2(), sampler.next2())
         };
-    (point, lens)
+        let film = Vec2::new(x as f32, y as f32)
+            + match settings.filter {
+                PixelFilter::Box => jitter,
+                PixelFilter::Point => Vec2::splat(0.5),
+            };
+        PixelSample { sampler, film, lens }
+    }
+
+    /// The sample's camera ray in `scene`.
+    pub fn ray(&self, scene: &Scene) -> crate::geometry::Ray {
+        let s = scene.settings();
+        scene.camera().rays(s.width, s.height).ray(self.film, self.lens)
+    }
 }
