@@ -26,12 +26,12 @@ pub fn check(aovs: &[Aov], outputs: &[PathBuf], partial: bool, integrator: Integ
     if aovs.is_empty() {
         return Ok(());
     }
-    let single_scattering =
-        matches!(integrator, IntegratorKind::Raymarch | IntegratorKind::Analytic | IntegratorKind::Stochastic);
-    if aovs.contains(&Aov::Inscatter) && !single_scattering {
+    if aovs.contains(&Aov::Inscatter) && !integrator.separates_in_scattering() {
+        let those: Vec<&str> =
+            IntegratorKind::ALL.into_iter().filter(|k| k.separates_in_scattering()).map(|k| k.name()).collect();
         return Err(format!(
-            "--aov inscatter: the {integrator} integrator does not separate the medium's light; \
-             use raymarch, analytic or stochastic"
+            "--aov inscatter: the {integrator} integrator does not separate the medium's light; use {}",
+            airlight::options::one_of(&those)
         ));
     }
     if partial {

@@ -62,14 +62,10 @@ pub fn ladder(scene: &Scene, base: &IntegratorDesc, kinds: &[IntegratorKind]) ->
         plans.push(SeriesPlan { id, label, kind, setting, desc, attenuation: None, transport });
     };
     let medium = scene.medium().is_some();
-    for kind in [
-        IntegratorKind::Path,
-        IntegratorKind::Direct,
-        IntegratorKind::Raymarch,
-        IntegratorKind::Analytic,
-        IntegratorKind::Stochastic,
-        IntegratorKind::Radiosity,
-    ] {
+    // Every integrator there is, the path tracer first.
+    let mut order = IntegratorKind::ALL.to_vec();
+    order.sort_by_key(|k| *k != IntegratorKind::Path);
+    for kind in order {
         if !kinds.contains(&kind) {
             continue;
         }
