@@ -31,19 +31,67 @@ fn progressive_render_writes_the_image_and_matches_the_plain_one() {
     assert!(max < 1e-3, "{text}");
 }
 
+/// A point light in open fog, seen from 6 units away: rays pass it within a
+/// fraction of a unit, where drawing the point on the ray uniformly over
+/// its 100 units is far noisier than drawing it by angle.
+const POINT_IN_FOG: &str = r#"
+[render]
+width = 24
+height = 16
+integrator = "stochastic"
+spp = 32
+[camera]
+position = [0, 0, -6]
+look_at = [0, 0, 0]
+fov = 50
+[medium]
+sigma_a = 0.01
+sigma_s = 0.1
+[[lights]]
+type = "point"
+position = [0.3, 0.2, 0]
+intensity = 10
+"#;
+
+/// The red channel of an EXR's first layer.
+fn red(path: &Path) -> Vec<f64> {
+    use exr::prelude::*;
+    let image = read().no_deep_data().largest_resolution_level().all_channels().first_valid_layer().all_attributes();
+    let image = image.from_file(path).unwrap();
+    let channel = image.layer_data.channel_data.list.iter().find(|c| c.name.to_string() == "R").unwrap();
+    channel.sample_data.values_as_f32().map(f64::from).collect()
+}
+
 #[test]
-fn sampling_option_is_checked_and_changes_the_image() {
+fn sampling_option_is_checked_and_each_choice_is_unbiased_with_its_own_noise() {
     let dir = tempfile::tempdir().unwrap();
-    let scene = scene();
-    let common = ["render", &scene, "--width", "24", "--height", "16", "--spp", "2", "--quiet"];
-    let bad = airlight(dir.path(), &[&common[..], &["--sampling", "importance"]].concat());
+    std::fs::write(dir.path().join("fog.toml"), POINT_IN_FOG).unwrap();
+    let bad = airlight(dir.path(), &["render", "fog.toml", "--sampling", "importance", "-q"]);
     assert!(!bad.status.success());
-    assert!(String::from_utf8_lossy(&bad.stderr).contains("expected uniform, equiangular or mis"));
-    for (sampling, out) in [("uniform", "u.exr"), ("mis", "m.exr")] {
-        let run = airlight(dir.path(), &[&common[..], &["--sampling", sampling, "--no-stratify", "-o", out]].concat());
+    assert!(String::from_utf8_lossy(&bad.stderr).contains("possible values: uniform, equiangular, mis"));
+    // Each sampling: the image's sum over pixels and the variance of that
+    // sum (the per-pixel variances of the means, from independent samples).
+    let mut sums = Vec::new();
+    for sampling in ["uniform", "equiangular", "mis"] {
+        let (image, variance) = (format!("{sampling}.exr"), format!("{sampling}.var.exr"));
+        let args = ["render", "fog.toml", "--sampling", sampling, "--no-stratify", "-q", "-o", &image, "--variance"];
+        let run = airlight(dir.path(), &[&args[..], &[&variance]].concat());
         assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+        let sum: f64 = red(&dir.path().join(&image)).iter().sum();
+        let var: f64 = red(&dir.path().join(&variance)).iter().sum();
+        assert!(sum > 0.0 && var > 0.0, "{sampling}: {sum} {var}");
+        sums.push((sampling, sum, var));
     }
-    let a = std::fs::read(dir.path().join("u.exr")).unwrap();
-    let b = std::fs::read(dir.path().join("m.exr")).unwrap();
-    assert!(a != b);
+    // Three estimators of one integral: their images agree within their
+    // noise (a z-score of the difference of sums under 5)...
+    for (i, a) in sums.iter().enumerate() {
+        for b in &sums[i + 1..] {
+            let z = (a.1 - b.1) / (a.2 + b.2).sqrt();
+            assert!(z.abs() < 5.0, "{} against {}: z = {z} ({sums:?})", a.0, b.0);
+        }
+    }
+    // ...and the option is heard: sampling by angle near the light is far
+    // less noisy than sampling the 100-unit ray uniformly.
+    let (uniform, equiangular) = (sums[0].2, sums[1].2);
+    assert!(uniform > 4.0 * equiangular, "variance: uniform {uniform}, equiangular {equiangular}");
 }
