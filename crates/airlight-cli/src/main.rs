@@ -3,15 +3,14 @@
 use airlight::SceneFile;
 use airlight::film::{self, Image};
 use airlight::integrator::IntegratorKind;
-use airlight::integrator::MAX_BOUNCES;
 use airlight::render::RenderObserver;
-use airlight::scene::{MAX_IMAGE_SIDE, MAX_SPP};
 use clap::{Parser, Subcommand};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 mod aovs;
 mod merge;
+mod options;
 mod outputs;
 mod plot;
 mod preflight;
@@ -107,22 +106,10 @@ struct GiArgs {
     /// DIR/frame_0000.png, … (not timed).
     #[arg(long, value_name = "DIR")]
     output_dir: Option<PathBuf>,
-    /// Patch size (overrides the scene's render.patch_size).
-    #[arg(long)]
-    patch_size: Option<f32>,
-    /// Bounces (overrides render.bounces).
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=MAX_BOUNCES as i64))]
-    bounces: Option<u32>,
-    /// Link threshold (overrides render.link_threshold).
-    #[arg(long)]
-    link_threshold: Option<f32>,
-    /// Samples per pixel of written frames.
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=MAX_SPP as i64))]
-    spp: Option<u32>,
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=MAX_IMAGE_SIDE as i64))]
-    width: Option<u32>,
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=MAX_IMAGE_SIDE as i64))]
-    height: Option<u32>,
+    /// Film settings and the radiosity integrator's options (and, in a
+    /// medium, the march's), overriding the scene's `[render]`.
+    #[command(flatten)]
+    options: options::OptionFlags,
     /// Worker threads (default: all cores).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=crate::preflight::MAX_THREADS as i64))]
     threads: Option<u32>,
@@ -163,29 +150,27 @@ fn load(path: Option<&Path>) -> Result<SceneFile, String> {
     }
 }
 
-/// Sets `slot` to the command line's value where the option was given.
-fn set_given<T>(slot: &mut T, given: Option<T>) {
-    if let Some(value) = given {
-        *slot = value;
-    }
-}
-
 fn gi(args: GiArgs) -> Result<(), String> {
     use airlight::integrator::{Integrator, RadiosityIntegrator};
     use airlight::render::{frame_time, render, set_time};
     let SceneFile { mut scene, integrator: mut desc } = load(Some(&args.scene))?;
-    let options = &mut desc.radiosity;
-    if let Some(v) = args.patch_size {
-        options.patch_size = Some(v);
+    // Every option but the radiosity integrator's (and its march's) would
+    // be ignored here: refuse it rather than let it pass unheard.
+    for (key, _) in &args.options.given {
+        if let Some(o) = airlight::integrator::IntegratorDesc::option(key)
+            && !o.takes.contains(&IntegratorKind::Radiosity)
+        {
+            let takes: Vec<&str> = o.takes.iter().map(|k| k.name()).collect();
+            return Err(format!(
+                "{}: `gi` renders with radiosity, which does not read this option (it is of {})",
+                airlight::options::flag(key),
+                takes.join(", ")
+            ));
+        }
     }
-    set_given(&mut options.link_threshold, args.link_threshold);
-    set_given(&mut options.bounces, args.bounces);
-    desc.validate().map_err(|e| format!("--{}", e.to_string().replace('_', "-")))?;
-    let s = scene.settings_mut();
-    set_given(&mut s.spp, args.spp);
-    set_given(&mut s.width, args.width);
-    set_given(&mut s.height, args.height);
-    s.validate()?;
+    let mut settings = scene.settings().clone();
+    args.options.apply(&mut settings, &mut desc)?;
+    *scene.settings_mut() = settings;
     if let Some(dir) = &args.output_dir {
         outputs::check_folder("--output-dir", dir)?;
         let film = if scene.settings().adaptive {

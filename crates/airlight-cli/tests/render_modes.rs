@@ -193,7 +193,7 @@ fn reuse_comes_from_the_flag_or_the_scene_file_and_a_bad_value_is_placed() {
     let run = airlight(dir.path(), &[&["render", "bad.toml"][..], &size].concat());
     let stderr = String::from_utf8_lossy(&run.stderr);
     assert!(
-        !run.status.success() && stderr.contains("bad.toml:5") && stderr.contains("expected a boolean"),
+        !run.status.success() && stderr.contains("bad.toml:5") && stderr.contains("render.reuse must be true or false"),
         "{stderr}"
     );
 }

@@ -9,7 +9,7 @@
 //! scenes take turns.
 
 use crate::errors::{Origin, guard, scene_error};
-use crate::options::{self, Film};
+use crate::options;
 use crate::render::{self, Job, Output, Progress};
 use airlight::SceneFile;
 use airlight::aov::Aov;
@@ -363,7 +363,6 @@ impl PyScene {
     ///
     /// - `integrator`: direct, raymarch, analytic, stochastic, path or
     ///   radiosity (default: the scene's).
-    /// - `spp`, `seed`, `width`, `height`: override the scene's `[render]`.
     /// - `threads`: worker threads (default: every core); the image does
     ///   not depend on it.
     /// - `shard=(k, n)`: only the k-th of n ranges of each pixel's samples
@@ -378,28 +377,27 @@ impl PyScene {
     ///   over the render's camera rays, and `variance` (of each pixel's
     ///   mean), as asked: the layers `airlight render --aov` writes. Not
     ///   with `shard`.
-    /// - Other keywords are integrator options by their scene-file names:
-    ///   steps, jitter, shadows, light_steps, light_quadrature, sampling,
-    ///   stratify, max_depth, bounces, patch_size, link_threshold; checked
-    ///   as the file checks them (`IntegratorError`).
+    /// - Every other keyword is a key of a scene file's `[render]` table
+    ///   with the same meaning, overriding the scene's: the film settings
+    ///   (`spp`, `seed`, `width`, `height`, `exposure`, `tonemap`, …) and
+    ///   the integrator options (`steps`, `stratify`, `reuse`, …); None
+    ///   gives the option's default. Each is checked by the declaration
+    ///   the file and the CLI use: a value of the wrong kind raises
+    ///   `TypeError`, an integrator option out of bounds `IntegratorError`,
+    ///   a film setting out of bounds `ValueError`.
     ///
     /// The GIL is released while rendering; Ctrl-C (looked for every 50 ms)
     /// stops the render and raises KeyboardInterrupt. An image too large
     /// for the memory left raises MemoryError; a scene that can only be
     /// black gives a UserWarning, as the CLI warns.
     #[pyo3(signature = (
-        integrator=None, *, spp=None, seed=None, width=None, height=None, threads=None,
-        shard=None, progress=None, aovs=None, **options
+        integrator=None, *, threads=None, shard=None, progress=None, aovs=None, **options
     ))]
     #[allow(clippy::too_many_arguments)]
     fn render<'py>(
         &self,
         py: Python<'py>,
         integrator: Option<&Bound<'py, PyAny>>,
-        spp: Option<&Bound<'py, PyAny>>,
-        seed: Option<&Bound<'py, PyAny>>,
-        width: Option<&Bound<'py, PyAny>>,
-        height: Option<&Bound<'py, PyAny>>,
         threads: Option<i64>,
         shard: Option<(i64, i64)>,
         progress: Option<&Bound<'py, PyAny>>,
@@ -407,8 +405,11 @@ impl PyScene {
         options: Option<&Bound<'py, PyDict>>,
     ) -> PyResult<Bound<'py, PyAny>> {
         guard(|| {
-            let settings = Film { spp, seed, width, height }.apply(&self.settings)?;
-            let desc = options::integrator(self.integrator, integrator, options)?;
+            let given: Vec<(String, Bound<'py, PyAny>)> = match options {
+                Some(o) => o.iter().map(|(k, v)| Ok((k.extract::<String>()?, v))).collect::<PyResult<_>>()?,
+                None => Vec::new(),
+            };
+            let (settings, desc) = options::apply(&self.settings, self.integrator, integrator, &given)?;
             let threads = match threads {
                 None => 0,
                 Some(n) if (1..=MAX_THREADS).contains(&n) => n as usize,

@@ -112,7 +112,7 @@ def test_option_errors_are_the_scene_file_messages(cli, tmp_path):
         scene.render(link_threshold=-1.0)
     with pytest.raises(airlight.IntegratorError, match="^unknown integrator `pathtracer`; expected one of direct"):
         scene.render("pathtracer")
-    with pytest.raises(airlight.IntegratorError, match="^sampling: unknown sampling `best`"):
+    with pytest.raises(airlight.IntegratorError, match="^sampling must be uniform, equiangular or mis, got the text \"best\"$"):
         scene.render(sampling="best")
     with pytest.raises(TypeError, match="unexpected keyword argument 'step'"):
         scene.render(step=4)

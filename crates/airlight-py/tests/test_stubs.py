@@ -11,8 +11,8 @@ import pytest
 import airlight
 
 STUB = pathlib.Path(airlight.__file__).with_name("__init__.pyi")
-# render()'s film and control arguments; the other keywords are integrator options.
-FILM = {"integrator", "spp", "seed", "width", "height", "threads", "shard", "progress", "aovs"}
+# render()'s control arguments; the other keywords are the keys of [render].
+CONTROL = {"integrator", "threads", "shard", "progress", "aovs"}
 
 
 def stub_tree():
@@ -55,11 +55,11 @@ def test_the_render_keywords_of_the_stubs_are_the_ones_render_takes():
     assert len(overloads) == 2
     for f in overloads:
         names = {a.arg for a in f.args.args[1:] + f.args.kwonlyargs}
-        # An unknown keyword's message lists the integrator options render() takes.
+        # An unknown keyword's message lists the [render] keys render() takes.
         with pytest.raises(TypeError) as e:
             airlight.loads("").render(no_such_option=1)
-        options = set(str(e.value).split("the integrator options are ")[1].split(", "))
-        assert names == FILM | options
+        options = set(str(e.value).split("it takes ")[1].split(", "))
+        assert names == CONTROL | options
 
 
 def test_every_public_object_has_a_docstring():

@@ -38,6 +38,7 @@ pub mod light;
 pub mod material;
 pub mod medium;
 pub mod memory;
+pub mod options;
 pub mod preview;
 pub mod radiosity;
 pub mod render;

@@ -22,34 +22,15 @@ use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::path::Path;
 use std::time::Instant;
 
-/// Key and value names of the scene format, for renames and swaps.
-const NAMES: &[&str] = &[
+/// Key and value names of the scene format, for renames and swaps, besides
+/// the keys of `[render]` (see [`names`]).
+const OTHER_NAMES: &[&str] = &[
     "render",
     "camera",
     "medium",
     "materials",
     "objects",
     "lights",
-    "width",
-    "height",
-    "spp",
-    "steps",
-    "integrator",
-    "seed",
-    "max_distance",
-    "background",
-    "exposure",
-    "tonemap",
-    "filter",
-    "jitter",
-    "shadows",
-    "light_steps",
-    "sampling",
-    "stratify",
-    "max_depth",
-    "bounces",
-    "patch_size",
-    "link_threshold",
     "type",
     "position",
     "look_at",
@@ -118,12 +99,17 @@ const NAMES: &[&str] = &[
     "radiosity",
     "isometric",
     "orthographic",
-    "height",
     "checker",
     "phong",
     "smooth_union",
     "mesh.obj",
 ];
+
+/// Every key and value name the mutations use: the `[render]` keys as
+/// declared, then [`OTHER_NAMES`].
+fn names() -> Vec<&'static str> {
+    airlight::SceneFile::render_keys().chain(OTHER_NAMES.iter().copied()).collect()
+}
 
 /// A scene with a mesh, and the mesh: a cube of quads, with the
 /// statements an OBJ exporter writes that Airlight skips.
@@ -216,7 +202,7 @@ fn scene_input(seed: u64, bases: &[toml::Table], dir: &Path) -> Result<bool, Str
     let mut doc = rng.pick(bases).clone();
     let has_mesh = toml::to_string(&doc).is_ok_and(|t| t.contains("mesh.obj"));
     if !has_mesh || rng.chance(3) {
-        mutate_tree(&mut rng, &mut doc, NAMES, 3);
+        mutate_tree(&mut rng, &mut doc, &names(), 3);
     }
     let text = toml::to_string(&doc).map_err(|e| format!("the mutator wrote no TOML: {e}"))?;
     let bytes = if rng.chance(4) { mutate_text(&mut rng, &text) } else { text.into_bytes() };

@@ -1,11 +1,9 @@
 //! What `airlight render`'s command line says: its arguments, checked as
 //! clap parses them, and the scene file with their overrides applied.
 
-use crate::{load, set_given};
+use crate::load;
+use crate::options::OptionFlags;
 use airlight::SceneFile;
-use airlight::integrator::analytic::LightQuadrature;
-use airlight::integrator::{IntegratorKind, MAX_LIGHT_STEPS, MAX_STEPS, Sampling};
-use airlight::scene::{MAX_IMAGE_SIDE, MAX_SPP};
 use std::path::PathBuf;
 
 #[derive(clap::Args)]
@@ -16,20 +14,6 @@ pub struct RenderArgs {
     /// Default: airlight.png for the demo, else the scene's name with .png.
     #[arg(short, long = "output", value_name = "OUT")]
     pub(super) output: Vec<PathBuf>,
-    /// Integrator: direct, raymarch, analytic, stochastic, path, radiosity.
-    #[arg(long)]
-    pub(super) integrator: Option<IntegratorKind>,
-    /// Stochastic: how points on the camera segment are drawn: uniform,
-    /// equiangular or mis.
-    #[arg(long)]
-    pub(super) sampling: Option<Sampling>,
-    /// Stochastic: independent random samples instead of stratified ones.
-    #[arg(long)]
-    pub(super) no_stratify: bool,
-    /// Path: neighbouring pixels' paths share what they gather beyond their
-    /// second vertex (scenes without a medium). As `[render] reuse`.
-    #[arg(long)]
-    pub(super) reuse: bool,
     /// Render in passes of 1, 1, 2, 4, ... samples per pixel up to spp,
     /// rewriting the output after each pass.
     #[arg(long)]
@@ -66,36 +50,10 @@ pub struct RenderArgs {
     /// finished image is the one an uninterrupted render gives, bit for bit.
     #[arg(long, requires = "progressive")]
     pub(super) resume: bool,
-    /// Samples per pixel.
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=MAX_SPP as i64))]
-    pub(super) spp: Option<u32>,
-    /// Spread the samples over the pixels by their noise: spp a pixel on
-    /// average, more where a pilot pass found the image noisy (the edges of
-    /// lights in view), fewer where it is smooth. As `[render] adaptive`.
-    #[arg(long)]
-    pub(super) adaptive: bool,
-    /// March samples per ray.
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=MAX_STEPS as i64))]
-    pub(super) steps: Option<u32>,
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=MAX_IMAGE_SIDE as i64))]
-    pub(super) width: Option<u32>,
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=MAX_IMAGE_SIDE as i64))]
-    pub(super) height: Option<u32>,
-    #[arg(long)]
-    pub(super) seed: Option<u64>,
     /// Falloff for every point, spot and sphere light: physical, sphere,
     /// cutoff, window_tan, window_rational, window_ue4 (each keeps its cutoff).
     #[arg(long, value_parser = parse_attenuation)]
     pub(super) attenuation: Option<airlight::light::AttenuationModel>,
-    /// analytic: volumetric shadows (the lit intervals of each ray).
-    #[arg(long)]
-    pub(super) shadows: bool,
-    /// analytic: points per dimension over line and quad lights.
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=MAX_LIGHT_STEPS as i64))]
-    pub(super) light_steps: Option<u32>,
-    /// analytic: gauss (Gauss–Legendre) or uniform (equal steps) over lights.
-    #[arg(long, value_parser = parse_light_quadrature)]
-    pub(super) light_quadrature: Option<LightQuadrature>,
     /// A medium instead of the scene's (a glTF file has none): the keys of
     /// a scene file's `[medium]` as `key=value` pairs separated by commas,
     /// e.g. `sigma_s=0.05,sigma_a=0.01,g=0.3`, `sigma_s=[0.1,0.1,0.2]` or
@@ -111,6 +69,8 @@ pub struct RenderArgs {
     /// medium's light alone (raymarch, analytic, stochastic)
     #[arg(long, value_name = "LIST", value_parser = crate::aovs::parse_list)]
     pub(super) aov: Option<crate::aovs::AovList>,
+    #[command(flatten)]
+    pub(super) options: OptionFlags,
     /// No progress bar or summary.
     #[arg(long, short)]
     pub(super) quiet: bool,
@@ -119,31 +79,9 @@ pub struct RenderArgs {
 /// The scene file with the command line's overrides applied and checked.
 pub(super) fn configure(args: &RenderArgs) -> Result<SceneFile, String> {
     let mut file = load(args.scene.as_deref())?;
-    let s = file.scene.settings_mut();
-    set_given(&mut s.spp, args.spp);
-    set_given(&mut s.width, args.width);
-    set_given(&mut s.height, args.height);
-    set_given(&mut s.seed, args.seed);
-    if args.adaptive {
-        s.adaptive = true;
-    }
-    s.validate()?;
-    let d = &mut file.integrator;
-    set_given(&mut d.kind, args.integrator);
-    set_given(&mut d.raymarch.steps, args.steps);
-    set_given(&mut d.stochastic.sampling, args.sampling);
-    if args.reuse {
-        d.path.reuse = true;
-    }
-    if args.no_stratify {
-        d.stochastic.stratify = false;
-    }
-    if args.shadows {
-        d.analytic.shadows = true;
-    }
-    set_given(&mut d.analytic.light_steps, args.light_steps);
-    set_given(&mut d.analytic.quadrature, args.light_quadrature);
-    d.validate().map_err(|e| format!("--{}", e.to_string().replace('_', "-")))?;
+    let mut settings = file.scene.settings().clone();
+    args.options.apply(&mut settings, &mut file.integrator)?;
+    *file.scene.settings_mut() = settings;
     if let Some(model) = args.attenuation {
         file.scene.set_attenuation_model(model).map_err(|e| format!("--attenuation: {e}"))?;
     }
@@ -198,10 +136,6 @@ fn parse_part(s: &str) -> Result<(u32, u32), String> {
     let (k, n) = s.split_once('/').ok_or_else(bad)?;
     let (k, n): (u32, u32) = (k.trim().parse().map_err(|_| bad())?, n.trim().parse().map_err(|_| bad())?);
     if k < n { Ok((k, n)) } else { Err(bad()) }
-}
-
-fn parse_light_quadrature(s: &str) -> Result<LightQuadrature, String> {
-    s.parse()
 }
 
 fn parse_attenuation(s: &str) -> Result<airlight::light::AttenuationModel, String> {

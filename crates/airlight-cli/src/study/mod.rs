@@ -18,9 +18,9 @@ mod run;
 mod steps;
 mod table;
 
+use crate::load;
 use crate::outputs::{self, Output};
 use crate::progress::Progress;
-use crate::{load, set_given};
 use airlight::SceneFile;
 use airlight::film::Image;
 use airlight::integrator::IntegratorKind;
@@ -77,9 +77,9 @@ const TRUTH_SEEDS: [u64; 2] = [0x7275_7468_0001, 0x7275_7468_0002];
 fn scene_file(args: &StudyArgs) -> Result<SceneFile, String> {
     let mut file = load(Some(&args.scene))?;
     let s = file.scene.settings_mut();
-    set_given(&mut s.width, args.width);
-    set_given(&mut s.height, args.height);
-    set_given(&mut s.seed, args.seed);
+    s.width = args.width.unwrap_or(s.width);
+    s.height = args.height.unwrap_or(s.height);
+    s.seed = args.seed.unwrap_or(s.seed);
     s.spp = MAX_SPP;
     s.validate()?;
     Ok(file)

@@ -20,8 +20,9 @@ pub use batch::first_surface_batch;
 pub use direct::Direct;
 pub use equiangular::Equiangular;
 pub use options::{
-    DEFAULT_LINK_THRESHOLD, IntegratorDesc, IntegratorError, MAX_BOUNCES, MAX_DEPTH, MAX_LIGHT_STEPS, MAX_STEPS,
-    OptionError, PathOptions, RadiosityOptions, RaymarchOptions, StochasticOptions,
+    DEFAULT_LINK_THRESHOLD, INTEGRATOR_OPTIONS, IntegratorDesc, IntegratorError, IntegratorOption, MAX_BOUNCES,
+    MAX_DEPTH, MAX_LIGHT_STEPS, MAX_STEPS, OptionError, PathOptions, RadiosityOptions, RaymarchOptions,
+    StochasticOptions,
 };
 pub use path::PathTracer;
 pub use radiosity::{RadiosityIntegrator, indirect_radiance};
@@ -126,6 +127,17 @@ impl IntegratorKind {
         IntegratorKind::Path,
         IntegratorKind::Radiosity,
     ];
+
+    /// Whether the integrator's [`Integrator::radiance_parts`] gives the
+    /// surface's light and the medium's apart (the single-scattering
+    /// integrators), so that the medium's light can be written alone; known
+    /// before the integrator is built (radiosity's build is long).
+    pub fn separates_in_scattering(self) -> bool {
+        match self {
+            IntegratorKind::Raymarch | IntegratorKind::Analytic | IntegratorKind::Stochastic => true,
+            IntegratorKind::Direct | IntegratorKind::Path | IntegratorKind::Radiosity => false,
+        }
+    }
 
     pub fn name(self) -> &'static str {
         match self {

@@ -6,14 +6,21 @@
 //! (`steps` for raymarch, `bounces` for radiosity, …) and the command line
 //! may pick another integrator than the file names, so a description keeps
 //! the options of every integrator and `kind` says which one is built.
+//!
+//! Every option is declared once, in [`INTEGRATOR_OPTIONS`]: key, kind of
+//! value with its bounds, doc line and the integrators that read it. The
+//! scene file, the command line and Python set options through it, and
+//! [`IntegratorDesc::validate`] checks by it.
 
 use super::analytic::{AnalyticOptions, LightQuadrature};
 use super::{
     Analytic, Direct, Integrator, IntegratorKind, PathTracer, RadiosityIntegrator, Raymarch, Sampling, Stochastic,
 };
+use crate::options::{Checked, NumberRange, OptionSpec, OptionValue, ValueKind, set_named};
 use crate::radiosity::RadiosityError;
 use crate::scene::Scene;
-use crate::scene::desc::{FieldError, RenderDesc, parse_name, render_count};
+
+pub use crate::options::OptionError;
 
 /// Most march samples per ray (`steps`).
 pub const MAX_STEPS: u32 = 1 << 20;
@@ -23,21 +30,6 @@ pub const MAX_LIGHT_STEPS: u32 = 4096;
 pub const MAX_DEPTH: u32 = 1 << 16;
 /// Most radiosity bounces (`bounces`).
 pub const MAX_BOUNCES: u32 = 1024;
-
-/// An option whose value is out of bounds: its key (as the scene file
-/// spells it) and what was expected.
-#[derive(Clone, Debug, PartialEq, thiserror::Error)]
-#[error("{key} {message}")]
-pub struct OptionError {
-    pub key: &'static str,
-    pub message: String,
-}
-
-impl OptionError {
-    fn new(key: &'static str, message: impl Into<String>) -> Self {
-        OptionError { key, message: message.into() }
-    }
-}
 
 /// Why an integrator could not be built, or relit.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
@@ -50,14 +42,6 @@ pub enum IntegratorError {
     Unsupported { integrator: IntegratorKind, reason: String },
     #[error(transparent)]
     Radiosity(#[from] RadiosityError),
-}
-
-fn count_in(key: &'static str, value: u32, min: u32, max: u32) -> Result<(), OptionError> {
-    if (min..=max).contains(&value) {
-        Ok(())
-    } else {
-        Err(OptionError::new(key, format!("must be an integer from {min} to {max}, got {value}")))
-    }
 }
 
 /// `raymarch`: a shadow ray from each of `steps` samples along the ray.
@@ -73,18 +57,6 @@ pub struct RaymarchOptions {
 impl Default for RaymarchOptions {
     fn default() -> Self {
         RaymarchOptions { steps: 64, jitter: true }
-    }
-}
-
-impl RaymarchOptions {
-    pub fn validate(&self) -> Result<(), OptionError> {
-        count_in("steps", self.steps, 1, MAX_STEPS)
-    }
-}
-
-impl AnalyticOptions {
-    pub fn validate(&self) -> Result<(), OptionError> {
-        count_in("light_steps", self.light_steps, 1, MAX_LIGHT_STEPS)
     }
 }
 
@@ -123,12 +95,6 @@ impl Default for PathOptions {
     }
 }
 
-impl PathOptions {
-    pub fn validate(&self) -> Result<(), OptionError> {
-        count_in("max_depth", self.max_depth, 1, MAX_DEPTH)
-    }
-}
-
 /// Default of [`RadiosityOptions::link_threshold`].
 pub const DEFAULT_LINK_THRESHOLD: f32 = 0.02;
 
@@ -154,18 +120,15 @@ impl Default for RadiosityOptions {
 }
 
 impl RadiosityOptions {
+    /// Checks the radiosity options by their declarations.
     pub fn validate(&self) -> Result<(), OptionError> {
-        count_in("bounces", self.bounces, 1, MAX_BOUNCES)?;
-        if let Some(p) = self.patch_size
-            && !(p.is_finite() && p > 0.0)
-        {
-            return Err(OptionError::new("patch_size", format!("must be a positive number, got {p}")));
-        }
-        let t = self.link_threshold;
-        if !(t.is_finite() && t >= 0.0) {
-            return Err(OptionError::new("link_threshold", format!("must be a finite number ≥ 0, got {t}")));
-        }
-        Ok(())
+        IntegratorDesc { radiosity: *self, ..IntegratorDesc::default() }.validate()
+    }
+}
+
+impl Default for AnalyticOptions {
+    fn default() -> Self {
+        AnalyticOptions { shadows: false, light_steps: 16, quadrature: LightQuadrature::Gauss }
     }
 }
 
@@ -187,6 +150,189 @@ impl Default for IntegratorDesc {
     }
 }
 
+/// One integrator option: its declaration and the integrators that read it.
+pub struct IntegratorOption {
+    pub spec: OptionSpec<IntegratorDesc>,
+    /// The integrators whose images depend on it.
+    pub takes: &'static [IntegratorKind],
+}
+
+use IntegratorKind::{Analytic as AnalyticKind, Path as PathKind, Radiosity as RadiosityKind};
+use IntegratorKind::{Raymarch as RaymarchKind, Stochastic as StochasticKind};
+
+/// A count as an option value.
+fn count(n: u32) -> OptionValue {
+    OptionValue::Int(n as i128)
+}
+
+/// Every integrator option, in the order the docs list them.
+pub const INTEGRATOR_OPTIONS: &[IntegratorOption] = &[
+    IntegratorOption {
+        spec: OptionSpec {
+            key: "integrator",
+            kind: ValueKind::Name(&["direct", "raymarch", "analytic", "stochastic", "path", "radiosity"]),
+            unit: "",
+            doc: "The integrator that renders the image.",
+            default_doc: Some("raymarch if the scene has a medium, else direct"),
+            get: |d| OptionValue::Text(d.kind.name().into()),
+            set: |d, v| set_named(&mut d.kind, v),
+        },
+        takes: &IntegratorKind::ALL,
+    },
+    IntegratorOption {
+        spec: OptionSpec {
+            key: "steps",
+            kind: ValueKind::Count { min: 1, max: MAX_STEPS as u64 },
+            unit: "",
+            doc: "March samples per camera ray, each with a shadow ray to each light.",
+            default_doc: None,
+            get: |d| count(d.raymarch.steps),
+            set: |d, v| d.raymarch.steps = v.count() as u32,
+        },
+        takes: &[RaymarchKind, RadiosityKind],
+    },
+    IntegratorOption {
+        spec: OptionSpec {
+            key: "jitter",
+            kind: ValueKind::Bool,
+            unit: "",
+            doc: "Offset the march samples by a random fraction of a step (else at each step's middle).",
+            default_doc: None,
+            get: |d| OptionValue::Bool(d.raymarch.jitter),
+            set: |d, v| d.raymarch.jitter = v.bool(),
+        },
+        takes: &[RaymarchKind, RadiosityKind],
+    },
+    IntegratorOption {
+        spec: OptionSpec {
+            key: "shadows",
+            kind: ValueKind::Bool,
+            unit: "",
+            doc: "Volumetric shadows: integrate only the lit intervals of each ray.",
+            default_doc: None,
+            get: |d| OptionValue::Bool(d.analytic.shadows),
+            set: |d, v| d.analytic.shadows = v.bool(),
+        },
+        takes: &[AnalyticKind],
+    },
+    IntegratorOption {
+        spec: OptionSpec {
+            key: "light_steps",
+            kind: ValueKind::Count { min: 1, max: MAX_LIGHT_STEPS as u64 },
+            unit: "",
+            doc: "Points per dimension over line, quad and triangle lights.",
+            default_doc: None,
+            get: |d| count(d.analytic.light_steps),
+            set: |d, v| d.analytic.light_steps = v.count() as u32,
+        },
+        takes: &[AnalyticKind],
+    },
+    IntegratorOption {
+        spec: OptionSpec {
+            key: "light_quadrature",
+            kind: ValueKind::Name(&["gauss", "uniform"]),
+            unit: "",
+            doc: "How points are placed over a light: Gauss–Legendre nodes, or equal steps (Packard's).",
+            default_doc: None,
+            get: |d| OptionValue::Text(d.analytic.quadrature.name().into()),
+            set: |d, v| set_named(&mut d.analytic.quadrature, v),
+        },
+        takes: &[AnalyticKind],
+    },
+    IntegratorOption {
+        spec: OptionSpec {
+            key: "sampling",
+            kind: ValueKind::Name(&["uniform", "equiangular", "mis"]),
+            unit: "",
+            doc: "How the point on the camera segment is drawn.",
+            default_doc: None,
+            get: |d| OptionValue::Text(d.stochastic.sampling.name().into()),
+            set: |d, v| set_named(&mut d.stochastic.sampling, v),
+        },
+        takes: &[StochasticKind],
+    },
+    IntegratorOption {
+        spec: OptionSpec {
+            key: "stratify",
+            kind: ValueKind::Bool,
+            unit: "",
+            doc: "Draw each pixel's samples from Owen-scrambled Sobol' points rather than independently.",
+            default_doc: None,
+            get: |d| OptionValue::Bool(d.stochastic.stratify && d.path.stratify),
+            set: |d, v| {
+                d.stochastic.stratify = v.bool();
+                d.path.stratify = v.bool();
+            },
+        },
+        takes: &[StochasticKind, PathKind],
+    },
+    IntegratorOption {
+        spec: OptionSpec {
+            key: "max_depth",
+            kind: ValueKind::Count { min: 1, max: MAX_DEPTH as u64 },
+            unit: "",
+            doc: "Most scattering events of a path; 1 is direct light and single scattering.",
+            default_doc: None,
+            get: |d| count(d.path.max_depth),
+            set: |d, v| d.path.max_depth = v.count() as u32,
+        },
+        takes: &[PathKind],
+    },
+    IntegratorOption {
+        spec: OptionSpec {
+            key: "reuse",
+            kind: ValueKind::Bool,
+            unit: "",
+            doc: "Neighbouring pixels' paths share what they gather beyond their second vertex (no medium).",
+            default_doc: None,
+            get: |d| OptionValue::Bool(d.path.reuse),
+            set: |d, v| d.path.reuse = v.bool(),
+        },
+        takes: &[PathKind],
+    },
+    IntegratorOption {
+        spec: OptionSpec {
+            key: "bounces",
+            kind: ValueKind::Count { min: 1, max: MAX_BOUNCES as u64 },
+            unit: "",
+            doc: "Bounces of indirect light.",
+            default_doc: None,
+            get: |d| count(d.radiosity.bounces),
+            set: |d, v| d.radiosity.bounces = v.count() as u32,
+        },
+        takes: &[RadiosityKind],
+    },
+    IntegratorOption {
+        spec: OptionSpec {
+            key: "patch_size",
+            kind: ValueKind::Number(NumberRange::Positive),
+            unit: "world units",
+            doc: "Side length surfaces are cut into patches of.",
+            default_doc: Some("1/32 of the bounded geometry's largest extent"),
+            get: |d| d.radiosity.patch_size.map_or(OptionValue::Default, OptionValue::real),
+            set: |d, v| {
+                d.radiosity.patch_size = match v {
+                    Checked::Default => None,
+                    v => Some(v.number() as f32),
+                };
+            },
+        },
+        takes: &[RadiosityKind],
+    },
+    IntegratorOption {
+        spec: OptionSpec {
+            key: "link_threshold",
+            kind: ValueKind::Number(NumberRange::NonNegative),
+            unit: "",
+            doc: "A patch links to a whole cluster whose form factor estimate A/(π d²) is below this; 0 links every pair.",
+            default_doc: None,
+            get: |d| OptionValue::real(d.radiosity.link_threshold),
+            set: |d, v| d.radiosity.link_threshold = v.number() as f32,
+        },
+        takes: &[RadiosityKind],
+    },
+];
+
 impl IntegratorDesc {
     /// `kind` with every option at its default.
     pub fn new(kind: IntegratorKind) -> Self {
@@ -206,13 +352,22 @@ impl IntegratorDesc {
         self
     }
 
-    /// Checks every option, whichever integrator is chosen (a scene file's
-    /// options must be valid even when the command line picks another).
+    /// The declaration of option `key`, if it is an integrator option.
+    pub fn option(key: &str) -> Option<&'static IntegratorOption> {
+        INTEGRATOR_OPTIONS.iter().find(|o| o.spec.key == key)
+    }
+
+    /// Sets option `key` to `value`, checked by its declaration.
+    /// None when no integrator has an option `key`.
+    pub fn set(&mut self, key: &str, value: &OptionValue) -> Option<Result<(), OptionError>> {
+        Self::option(key).map(|o| o.spec.apply(self, value))
+    }
+
+    /// Checks every option by its declaration, whichever integrator is
+    /// chosen (a scene file's options must be valid even when the command
+    /// line picks another).
     pub fn validate(&self) -> Result<(), OptionError> {
-        self.raymarch.validate()?;
-        self.analytic.validate()?;
-        self.path.validate()?;
-        self.radiosity.validate()
+        INTEGRATOR_OPTIONS.iter().try_for_each(|o| o.spec.validate(self))
     }
 
     /// Builds the integrator `kind` names for `scene`: the one place
@@ -233,78 +388,12 @@ impl IntegratorDesc {
     }
 }
 
-impl IntegratorDesc {
-    /// The integrator and options a scene file's `[render]` table names.
-    /// Without an `integrator` key: `raymarch` when the scene has a medium
-    /// (show the fog), else `direct`. Errors point at the value.
-    pub fn from_render_desc(r: &RenderDesc, has_medium: bool) -> Result<IntegratorDesc, FieldError> {
-        let default_kind = if has_medium { IntegratorKind::Raymarch } else { IntegratorKind::Direct };
-        let mut d = IntegratorDesc::new(default_kind);
-        if let Some(v) = &r.integrator {
-            d.kind = parse_name(v, "render.integrator")?;
-        }
-        if let Some(v) = &r.steps {
-            d.raymarch.steps = render_count(v, "steps", 1, MAX_STEPS)?;
-        }
-        if let Some(v) = r.jitter {
-            d.raymarch.jitter = v;
-        }
-        if let Some(v) = r.shadows {
-            d.analytic.shadows = v;
-        }
-        if let Some(v) = &r.light_steps {
-            d.analytic.light_steps = render_count(v, "light_steps", 1, MAX_LIGHT_STEPS)?;
-        }
-        if let Some(v) = &r.light_quadrature {
-            d.analytic.quadrature = parse_name(v, "render.light_quadrature")?;
-        }
-        if let Some(v) = &r.sampling {
-            d.stochastic.sampling = parse_name(v, "render.sampling")?;
-        }
-        if let Some(v) = r.stratify {
-            d.stochastic.stratify = v;
-            d.path.stratify = v;
-        }
-        if let Some(v) = r.reuse {
-            d.path.reuse = v;
-        }
-        if let Some(v) = &r.max_depth {
-            d.path.max_depth = render_count(v, "max_depth", 1, MAX_DEPTH)?;
-        }
-        if let Some(v) = &r.bounces {
-            d.radiosity.bounces = render_count(v, "bounces", 1, MAX_BOUNCES)?;
-        }
-        if let Some(v) = &r.patch_size {
-            d.radiosity.patch_size = Some(*v.get_ref());
-        }
-        if let Some(v) = &r.link_threshold {
-            d.radiosity.link_threshold = *v.get_ref();
-        }
-        // The checks each option type makes, placed at the key's value.
-        d.validate().map_err(|e| {
-            let span = match e.key {
-                "patch_size" => r.patch_size.as_ref().map(|v| v.span()),
-                "link_threshold" => r.link_threshold.as_ref().map(|v| v.span()),
-                _ => None,
-            };
-            FieldError { span: span.unwrap_or(0..0), message: format!("render.{e}") }
-        })?;
-        Ok(d)
-    }
-}
-
-impl Default for AnalyticOptions {
-    fn default() -> Self {
-        AnalyticOptions { shadows: false, light_steps: 16, quadrature: LightQuadrature::Gauss }
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
 
     #[test]
-    fn every_option_is_checked_by_its_own_type() {
+    fn every_option_is_checked_by_its_declaration() {
         let ok = IntegratorDesc::default();
         assert_eq!(ok.validate(), Ok(()));
         let cases: [(IntegratorDesc, &str); 6] = [
@@ -325,6 +414,51 @@ mod tests {
             let e = desc.validate().unwrap_err();
             assert_eq!(e.key, key, "{e}");
             assert!(e.to_string().starts_with(key), "{e}");
+        }
+    }
+
+    #[test]
+    fn each_option_reads_back_what_it_was_set_to() {
+        // Set each option to a value other than its default and read it
+        // back: a `get` that reads another field than `set` writes fails.
+        for o in INTEGRATOR_OPTIONS {
+            let spec = &o.spec;
+            let value = match spec.kind {
+                ValueKind::Bool => OptionValue::Bool((spec.get)(&IntegratorDesc::default()) != OptionValue::Bool(true)),
+                ValueKind::Count { min, .. } => OptionValue::Int(min as i128 + 2),
+                ValueKind::Number(_) => OptionValue::Float(0.375),
+                ValueKind::Colour => OptionValue::List(vec![0.25, 0.5, 0.75]),
+                ValueKind::Name(names) => OptionValue::Text(names[names.len() - 1].into()),
+            };
+            let mut d = IntegratorDesc::default();
+            spec.apply(&mut d, &value).unwrap_or_else(|e| panic!("{}: {e}", spec.key));
+            assert_eq!((spec.get)(&d), value, "{}", spec.key);
+            assert_ne!(d, IntegratorDesc::default(), "{} changed nothing", spec.key);
+            spec.apply(&mut d, &OptionValue::Default).unwrap();
+            assert_eq!((spec.get)(&d), (spec.get)(&IntegratorDesc::default()), "{} back to its default", spec.key);
+        }
+    }
+
+    #[test]
+    fn every_listed_name_is_known_to_its_type() {
+        for o in INTEGRATOR_OPTIONS {
+            if let ValueKind::Name(names) = o.spec.kind {
+                for name in names {
+                    let mut d = IntegratorDesc::default();
+                    o.spec.apply(&mut d, &OptionValue::Text((*name).into())).unwrap();
+                    assert_eq!((o.spec.get)(&d), OptionValue::Text((*name).into()));
+                }
+                let e = o.spec.apply(&mut IntegratorDesc::default(), &OptionValue::Text("nonesuch".into()));
+                assert!(e.is_err(), "{}", o.spec.key);
+            }
+        }
+    }
+
+    #[test]
+    fn every_integrator_but_direct_takes_an_option_of_its_own() {
+        for kind in IntegratorKind::ALL {
+            let own = INTEGRATOR_OPTIONS.iter().filter(|o| o.spec.key != "integrator" && o.takes.contains(&kind));
+            assert_eq!(own.count() == 0, kind == IntegratorKind::Direct, "{kind}");
         }
     }
 }

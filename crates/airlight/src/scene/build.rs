@@ -4,7 +4,7 @@
 use super::assets::AssetPath;
 use super::desc::*;
 use super::limits;
-use super::{MAX_IMAGE_SIDE, MAX_SPP, RenderSettings, Scene, SceneBuilder, SceneError, desc};
+use super::{MAX_IMAGE_SIDE, RENDER_SETTINGS, RenderSettings, Scene, SceneBuilder, SceneError};
 use glam::Vec3;
 use std::cell::{Cell, RefCell};
 use std::ops::Range;
@@ -93,8 +93,8 @@ impl Checker<'_> {
         // ratio sets the height when the file sets no size.
         let included_camera = included.iter_mut().find_map(|i| i.camera.take()).filter(|_| desc.camera.is_none());
         if let Some((_, Some(aspect))) = included_camera
-            && desc.render.width.is_none()
-            && desc.render.height.is_none()
+            && desc.render.get("width").is_none()
+            && desc.render.get("height").is_none()
             && aspect.is_finite()
             && aspect > 0.0
         {
@@ -135,45 +135,18 @@ impl Checker<'_> {
         builder.build()
     }
 
+    /// The film settings `[render]` gives, each checked by its declaration
+    /// (the integrators' options there are read by `SceneFile`).
     fn settings(&self, desc: &SceneDesc) -> Result<RenderSettings> {
         let r = &desc.render;
         let mut s = RenderSettings::default();
-        let located = |e: desc::FieldError| self.err(e.span, e.message);
-        if let Some(v) = &r.width {
-            s.width = desc::render_count(v, "width", 1, MAX_IMAGE_SIDE).map_err(located)?;
-        }
-        if let Some(v) = &r.height {
-            s.height = desc::render_count(v, "height", 1, MAX_IMAGE_SIDE).map_err(located)?;
-        }
-        if let Some(v) = &r.spp {
-            s.spp = desc::render_count(v, "spp", 1, MAX_SPP).map_err(located)?;
-        }
-        if let Some(seed) = &r.seed {
-            s.seed = *seed.get_ref() as u64;
-        }
-        if let Some(d) = &r.max_distance {
-            s.max_distance = self.positive(d.span(), "render.max_distance", *d.get_ref())?;
-        }
-        if let Some(b) = &r.background {
-            s.background = self.non_negative3(b.span(), "render.background", b.get_ref().0)?;
-        }
-        if let Some(e) = &r.exposure {
-            s.exposure = self.finite(e.span(), "render.exposure", *e.get_ref())?;
-        }
-        if let Some(t) = &r.tonemap {
-            s.tonemap = desc::parse_name(t, "render.tonemap").map_err(located)?;
-        }
-        if let Some(c) = r.cull_lights {
-            s.cull_lights = c;
-        }
-        if let Some(a) = r.adaptive {
-            s.adaptive = a;
-        }
-        if let Some(f) = &r.filter {
-            s.filter = desc::parse_name(f, "render.filter").map_err(located)?;
+        for spec in RENDER_SETTINGS {
+            if let Some(v) = r.get(spec.key) {
+                spec.apply(&mut s, v.get_ref()).map_err(|e| self.err(v.span(), format!("render.{e}")))?;
+            }
         }
         if let Err(message) = s.validate() {
-            let span = r.height.as_ref().or(r.width.as_ref()).map_or(0..0, |v| v.span());
+            let span = r.get("height").or(r.get("width")).map_or(0..0, |v| v.span());
             return Err(self.err(span, message));
         }
         Ok(s)

@@ -3,6 +3,7 @@
 //! and turns them into a [`Scene`](super::Scene).
 
 use crate::light::{AttenuationModel, SpotProfile};
+use crate::options::OptionValue;
 use glam::Vec3;
 use serde::Deserialize;
 use serde::de::{self, Deserializer, SeqAccess, Visitor};
@@ -42,46 +43,21 @@ pub struct IncludeDesc {
     pub scale: Option<Triple>,
 }
 
-/// The `[render]` table: film and sampling settings, which the scene keeps
-/// ([`super::RenderSettings`]), and the integrators' options, which
-/// [`crate::integrator::IntegratorDesc`] reads from here. Names of closed
-/// sets (integrator, tone curve, …) are read as text and checked by the type
-/// that owns them, at the value's position.
+/// The `[render]` table as written: each key with its value, both with
+/// their place in the text. Its keys are the film settings
+/// ([`super::RENDER_SETTINGS`]) and the integrators' options
+/// (`crate::integrator::INTEGRATOR_OPTIONS`); each is checked by its own
+/// declaration when read, and a key that neither reads is an error
+/// (`crate::SceneFile`).
 #[derive(Debug, Default, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct RenderDesc {
-    pub width: Option<Spanned<i64>>,
-    pub height: Option<Spanned<i64>>,
-    pub integrator: Option<Spanned<String>>,
-    pub spp: Option<Spanned<i64>>,
-    pub steps: Option<Spanned<i64>>,
-    pub max_distance: Option<Spanned<f32>>,
-    pub max_depth: Option<Spanned<i64>>,
-    pub seed: Option<Spanned<i64>>,
-    pub background: Option<Spanned<Triple>>,
-    pub exposure: Option<Spanned<f32>>,
-    pub tonemap: Option<Spanned<String>>,
-    pub jitter: Option<bool>,
-    pub cull_lights: Option<bool>,
-    pub adaptive: Option<bool>,
-    pub filter: Option<Spanned<String>>,
-    /// Radiosity: patch side length in world units (default: 1/32 of the
-    /// largest extent of the bounded geometry).
-    pub patch_size: Option<Spanned<f32>>,
-    /// Radiosity: bounces of indirect light (default 1).
-    pub bounces: Option<Spanned<i64>>,
-    /// Radiosity: largest estimated form factor A/(π d²) of a cluster that a
-    /// patch links to as a whole (default 0.02).
-    pub link_threshold: Option<Spanned<f32>>,
-    pub shadows: Option<bool>,
-    pub light_steps: Option<Spanned<i64>>,
-    pub light_quadrature: Option<Spanned<String>>,
-    /// Stochastic: uniform | equiangular | mis.
-    pub sampling: Option<Spanned<String>>,
-    /// Stochastic: stratify each pixel's samples.
-    pub stratify: Option<bool>,
-    /// Path: neighbouring pixels' paths share their second vertices.
-    pub reuse: Option<bool>,
+#[serde(transparent)]
+pub struct RenderDesc(pub BTreeMap<Spanned<String>, Spanned<OptionValue>>);
+
+impl RenderDesc {
+    /// The value given for `key`.
+    pub fn get(&self, key: &str) -> Option<&Spanned<OptionValue>> {
+        self.0.iter().find(|(k, _)| k.get_ref() == key).map(|(_, v)| v)
+    }
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
@@ -352,19 +328,6 @@ impl From<SpotProfileDesc> for SpotProfile {
 pub struct FieldError {
     pub span: std::ops::Range<usize>,
     pub message: String,
-}
-
-/// An integer key of `[render]` that must lie in [min, max].
-pub fn render_count(v: &Spanned<i64>, key: &str, min: u32, max: u32) -> Result<u32, FieldError> {
-    let n = *v.get_ref();
-    if (min as i64..=max as i64).contains(&n) {
-        Ok(n as u32)
-    } else {
-        Err(FieldError {
-            span: v.span(),
-            message: format!("render.{key} must be an integer from {min} to {max}, got {n}"),
-        })
-    }
 }
 
 /// A name from a closed set (an integrator, a tone curve, …), parsed by the

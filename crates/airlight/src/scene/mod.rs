@@ -28,120 +28,26 @@ mod mesh;
 mod mtl;
 pub mod obj;
 mod sdf;
+mod settings;
 mod texture_file;
 mod warnings;
 
 pub use assets::AssetPath;
-pub use build::{build, parse};
+pub(crate) use build::{build, parse};
 pub use build_materials::medium_from_options;
 pub use builder::SceneBuilder;
 pub use desc::SceneDesc;
 pub use error::{SceneError, line_col};
 pub use lights::LightCulling;
+pub use settings::{MAX_IMAGE_SIDE, MAX_PIXELS, MAX_SPP, PixelFilter, RENDER_SETTINGS, RenderSettings};
 
-use crate::Rgb;
 use crate::camera::Camera;
-use crate::film::Tonemap;
 use crate::geometry::{Geometry, GeometryBuilder, Shape, SurfaceHit};
 use crate::light::{Keyframes, Light};
 use crate::material::Material;
 use crate::medium::Medium;
 use emitters::Emitters;
 use glam::Vec3;
-
-/// The film and sampling settings of `[render]`: what every integrator
-/// shares. Integrators' own options live in [`crate::integrator`].
-#[derive(Clone, Debug, PartialEq)]
-pub struct RenderSettings {
-    pub width: u32,
-    pub height: u32,
-    /// Samples per pixel.
-    pub spp: u32,
-    pub seed: u64,
-    /// How far a ray that hits nothing is followed, and how far along any
-    /// camera ray the medium is integrated (a surface beyond it is still
-    /// seen, attenuated by the medium all the way).
-    pub max_distance: f32,
-    /// Radiance of rays that escape.
-    pub background: Rgb,
-    /// Stops, for PNG output only.
-    pub exposure: f32,
-    pub tonemap: Tonemap,
-    /// How a pixel gathers its samples.
-    pub filter: PixelFilter,
-    /// Skip lights whose range ends before a point (finite-range falloffs).
-    pub cull_lights: bool,
-    /// Spread the samples over the pixels by their noise, `spp` a pixel on
-    /// average (`render::adaptive`), rather than `spp` in every pixel.
-    pub adaptive: bool,
-}
-
-/// Largest image side.
-pub const MAX_IMAGE_SIDE: u32 = 1 << 16;
-/// Most pixels in an image (16384²).
-pub const MAX_PIXELS: u64 = 1 << 28;
-/// Most samples per pixel.
-pub const MAX_SPP: u32 = 1 << 24;
-
-impl RenderSettings {
-    /// Checks the sizes and counts; a message names the key and its bound.
-    pub fn validate(&self) -> Result<(), String> {
-        let (w, h) = (self.width, self.height);
-        if !(1..=MAX_IMAGE_SIDE).contains(&w) || !(1..=MAX_IMAGE_SIDE).contains(&h) {
-            return Err(format!("the image size must be from 1×1 to {MAX_IMAGE_SIDE}×{MAX_IMAGE_SIDE}, got {w}×{h}"));
-        }
-        if w as u64 * h as u64 > MAX_PIXELS {
-            return Err(format!("the image may have at most {MAX_PIXELS} pixels (16384²), got {w}×{h}"));
-        }
-        if !(1..=MAX_SPP).contains(&self.spp) {
-            return Err(format!("spp must be an integer from 1 to {MAX_SPP}, got {}", self.spp));
-        }
-        if !(self.max_distance.is_finite() && self.max_distance > 0.0) {
-            return Err(format!("max_distance must be a positive finite number, got {}", self.max_distance));
-        }
-        Ok(())
-    }
-}
-
-/// How the samples of a pixel are placed.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
-pub enum PixelFilter {
-    /// The mean over the pixel's square: samples jittered across it (anti-aliasing).
-    #[default]
-    Box,
-    /// Every sample through the pixel's centre: no anti-aliasing, but images
-    /// whose integrators take different sample counts share their camera rays.
-    Point,
-}
-
-impl std::str::FromStr for PixelFilter {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
-        match s {
-            "box" => Ok(PixelFilter::Box),
-            "point" => Ok(PixelFilter::Point),
-            _ => Err(format!("unknown filter `{s}`; expected box or point")),
-        }
-    }
-}
-
-impl Default for RenderSettings {
-    fn default() -> Self {
-        RenderSettings {
-            width: 640,
-            height: 480,
-            spp: 16,
-            seed: 0,
-            max_distance: 100.0,
-            background: Rgb::ZERO,
-            exposure: 0.0,
-            tonemap: Tonemap::Clamp,
-            filter: PixelFilter::Box,
-            cull_lights: true,
-            adaptive: false,
-        }
-    }
-}
 
 /// The material index of an area light's own surface: it reflects nothing.
 const LIGHT_SURFACE: u32 = u32::MAX;

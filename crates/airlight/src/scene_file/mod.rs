@@ -1,9 +1,10 @@
 //! Reading a scene file: the scene, and the integrator its `[render]` table
 //! asks for. The scene format is described in docs/scene-format.md.
 
-use crate::integrator::IntegratorDesc;
+use crate::integrator::{INTEGRATOR_OPTIONS, IntegratorDesc, IntegratorKind};
 use crate::scene::assets::read_text;
-use crate::scene::{self, AssetPath, Scene, SceneError};
+use crate::scene::desc::RenderDesc;
+use crate::scene::{self, AssetPath, RENDER_SETTINGS, Scene, SceneError};
 use std::path::{Path, PathBuf};
 
 /// A scene file, read and checked: the scene and the integrator it names,
@@ -53,11 +54,77 @@ impl SceneFile {
     /// Reads scene file text, with mesh files found in `assets`.
     pub fn from_toml_with(text: &str, assets: &AssetPath) -> Result<SceneFile, SceneError> {
         let desc = scene::parse(text)?;
-        let integrator = IntegratorDesc::from_render_desc(&desc.render, desc.medium.is_some())
-            .map_err(|e| SceneError::at(text, e.span.start, e.message))?;
+        check_render_keys(&desc.render, text)?;
+        let integrator = integrator_options(&desc.render, desc.medium.is_some(), text)?;
         let scene = scene::build(&desc, text, assets)?;
         Ok(SceneFile { scene, integrator })
     }
+}
+
+/// Every key of `[render]` is a film setting or an integrator option;
+/// any other is an error at the key, with the nearest known key if one
+/// is a slip of the pen away.
+fn check_render_keys(render: &RenderDesc, text: &str) -> Result<(), SceneError> {
+    let known: Vec<&str> = SceneFile::render_keys().collect();
+    for key in render.0.keys() {
+        let name = key.get_ref().as_str();
+        if known.contains(&name) {
+            continue;
+        }
+        let hint = known
+            .iter()
+            .filter(|k| edit_distance(k, name) <= 2)
+            .min_by_key(|k| edit_distance(k, name))
+            .map(|k| format!("did you mean `{k}`? "))
+            .unwrap_or_default();
+        return Err(SceneError::at(
+            text,
+            key.span().start,
+            format!("unknown field `{name}` in [render]; {hint}the keys of [render] are {}", known.join(", ")),
+        ));
+    }
+    Ok(())
+}
+
+impl SceneFile {
+    /// The keys `[render]` takes: the film settings, then the integrators'
+    /// options.
+    pub fn render_keys() -> impl Iterator<Item = &'static str> {
+        RENDER_SETTINGS.iter().map(|o| o.key).chain(INTEGRATOR_OPTIONS.iter().map(|o| o.spec.key))
+    }
+}
+
+/// The integrator and options `[render]` names. Without an `integrator`
+/// key: `raymarch` when the scene has a medium (show the fog), else
+/// `direct`. Errors point at the value.
+fn integrator_options(render: &RenderDesc, has_medium: bool, text: &str) -> Result<IntegratorDesc, SceneError> {
+    let default_kind = if has_medium { IntegratorKind::Raymarch } else { IntegratorKind::Direct };
+    let mut desc = IntegratorDesc::new(default_kind);
+    for option in INTEGRATOR_OPTIONS {
+        if let Some(v) = render.get(option.spec.key) {
+            option
+                .spec
+                .apply(&mut desc, v.get_ref())
+                .map_err(|e| SceneError::at(text, v.span().start, format!("render.{e}")))?;
+        }
+    }
+    Ok(desc)
+}
+
+/// The Levenshtein distance of two keys (ASCII), for "did you mean".
+fn edit_distance(a: &str, b: &str) -> usize {
+    let (a, b) = (a.as_bytes(), b.as_bytes());
+    let mut row: Vec<usize> = (0..=b.len()).collect();
+    for (i, &ca) in a.iter().enumerate() {
+        let mut diagonal = row[0];
+        row[0] = i + 1;
+        for (j, &cb) in b.iter().enumerate() {
+            let above = row[j + 1];
+            row[j + 1] = (diagonal + usize::from(ca != cb)).min(above + 1).min(row[j] + 1);
+            diagonal = above;
+        }
+    }
+    row[b.len()]
 }
 
 /// Whether `path` names a glTF file (`.gltf` or `.glb`, any case).

@@ -124,6 +124,16 @@ pub struct AnalyticOptions {
     pub quadrature: LightQuadrature,
 }
 
+impl LightQuadrature {
+    /// The name a scene file gives it.
+    pub fn name(self) -> &'static str {
+        match self {
+            LightQuadrature::Gauss => "gauss",
+            LightQuadrature::Uniform => "uniform",
+        }
+    }
+}
+
 impl std::str::FromStr for LightQuadrature {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {

@@ -1,0 +1,255 @@
+//! The film and sampling settings of a scene (`[render]`'s keys that are
+//! not an integrator's), each declared once in [`RENDER_SETTINGS`].
+
+use crate::Rgb;
+use crate::film::Tonemap;
+use crate::options::{NumberRange, OptionSpec, OptionValue, ValueKind, set_named};
+
+/// The film and sampling settings of `[render]`: what every integrator
+/// shares. Integrators' own options live in [`crate::integrator`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct RenderSettings {
+    pub width: u32,
+    pub height: u32,
+    /// Samples per pixel.
+    pub spp: u32,
+    pub seed: u64,
+    /// How far a ray that hits nothing is followed, and how far along any
+    /// camera ray the medium is integrated (a surface beyond it is still
+    /// seen, attenuated by the medium all the way).
+    pub max_distance: f32,
+    /// Radiance of rays that escape.
+    pub background: Rgb,
+    /// Stops, for PNG output only.
+    pub exposure: f32,
+    pub tonemap: Tonemap,
+    /// How a pixel gathers its samples.
+    pub filter: PixelFilter,
+    /// Skip lights whose range ends before a point (finite-range falloffs).
+    pub cull_lights: bool,
+    /// Spread the samples over the pixels by their noise, `spp` a pixel on
+    /// average (`render::adaptive`), rather than `spp` in every pixel.
+    pub adaptive: bool,
+}
+
+/// Largest image side.
+pub const MAX_IMAGE_SIDE: u32 = 1 << 16;
+/// Most pixels in an image (16384²).
+pub const MAX_PIXELS: u64 = 1 << 28;
+/// Most samples per pixel.
+pub const MAX_SPP: u32 = 1 << 24;
+
+impl RenderSettings {
+    /// Checks every setting by its declaration, and the image's pixel
+    /// count; a message names the key and its bound.
+    pub fn validate(&self) -> Result<(), String> {
+        RENDER_SETTINGS.iter().try_for_each(|o| o.validate(self)).map_err(|e| e.message)?;
+        let (w, h) = (self.width, self.height);
+        if w as u64 * h as u64 > MAX_PIXELS {
+            return Err(format!("the image may have at most {MAX_PIXELS} pixels (16384²), got {w}×{h}"));
+        }
+        Ok(())
+    }
+}
+
+/// How the samples of a pixel are placed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum PixelFilter {
+    /// The mean over the pixel's square: samples jittered across it (anti-aliasing).
+    #[default]
+    Box,
+    /// Every sample through the pixel's centre: no anti-aliasing, but images
+    /// whose integrators take different sample counts share their camera rays.
+    Point,
+}
+
+impl PixelFilter {
+    /// The name a scene file gives it.
+    pub fn name(self) -> &'static str {
+        match self {
+            PixelFilter::Box => "box",
+            PixelFilter::Point => "point",
+        }
+    }
+}
+
+impl std::str::FromStr for PixelFilter {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "box" => Ok(PixelFilter::Box),
+            "point" => Ok(PixelFilter::Point),
+            _ => Err(format!("unknown filter `{s}`; expected box or point")),
+        }
+    }
+}
+
+impl Default for RenderSettings {
+    fn default() -> Self {
+        RenderSettings {
+            width: 640,
+            height: 480,
+            spp: 16,
+            seed: 0,
+            max_distance: 100.0,
+            background: Rgb::ZERO,
+            exposure: 0.0,
+            tonemap: Tonemap::Clamp,
+            filter: PixelFilter::Box,
+            cull_lights: true,
+            adaptive: false,
+        }
+    }
+}
+
+/// A colour as an option value.
+fn colour(c: Rgb) -> OptionValue {
+    OptionValue::List(c.to_array().iter().map(|&x| x.to_string().parse().unwrap_or(x as f64)).collect())
+}
+
+/// Every film and sampling setting, in the order the docs list them.
+pub const RENDER_SETTINGS: &[OptionSpec<RenderSettings>] = &[
+    OptionSpec {
+        key: "width",
+        kind: ValueKind::Count { min: 1, max: MAX_IMAGE_SIDE as u64 },
+        unit: "pixels",
+        doc: "Image width.",
+        default_doc: None,
+        get: |s| OptionValue::Int(s.width as i128),
+        set: |s, v| s.width = v.count() as u32,
+    },
+    OptionSpec {
+        key: "height",
+        kind: ValueKind::Count { min: 1, max: MAX_IMAGE_SIDE as u64 },
+        unit: "pixels",
+        doc: "Image height (an included glTF camera's aspect ratio sets it when neither size is given).",
+        default_doc: None,
+        get: |s| OptionValue::Int(s.height as i128),
+        set: |s, v| s.height = v.count() as u32,
+    },
+    OptionSpec {
+        key: "spp",
+        kind: ValueKind::Count { min: 1, max: MAX_SPP as u64 },
+        unit: "",
+        doc: "Samples per pixel (on average, with adaptive sampling).",
+        default_doc: None,
+        get: |s| OptionValue::Int(s.spp as i128),
+        set: |s, v| s.spp = v.count() as u32,
+    },
+    OptionSpec {
+        key: "seed",
+        kind: ValueKind::Count { min: 0, max: i64::MAX as u64 },
+        unit: "",
+        doc: "Seed of every random stream; the same seed gives the same image.",
+        default_doc: None,
+        get: |s| OptionValue::Int(s.seed as i128),
+        set: |s, v| s.seed = v.count(),
+    },
+    OptionSpec {
+        key: "max_distance",
+        kind: ValueKind::Number(NumberRange::Positive),
+        unit: "world units",
+        doc: "How far a ray that hits nothing is followed, and how far the medium is integrated along it.",
+        default_doc: None,
+        get: |s| OptionValue::real(s.max_distance),
+        set: |s, v| s.max_distance = v.number() as f32,
+    },
+    OptionSpec {
+        key: "background",
+        kind: ValueKind::Colour,
+        unit: "W/(m² sr)",
+        doc: "Radiance of rays that escape.",
+        default_doc: None,
+        get: |s| colour(s.background),
+        set: |s, v| s.background = v.colour(),
+    },
+    OptionSpec {
+        key: "exposure",
+        kind: ValueKind::Number(NumberRange::Finite),
+        unit: "stops",
+        doc: "Scales the image by 2^exposure before the tone curve (PNG output only).",
+        default_doc: None,
+        get: |s| OptionValue::real(s.exposure),
+        set: |s, v| s.exposure = v.number() as f32,
+    },
+    OptionSpec {
+        key: "tonemap",
+        kind: ValueKind::Name(&["clamp", "filmic"]),
+        unit: "",
+        doc: "Tone curve for PNG output: clip to [0, 1], or the ACES filmic fit (Narkowicz 2015).",
+        default_doc: None,
+        get: |s| OptionValue::Text(s.tonemap.name().into()),
+        set: |s, v| set_named(&mut s.tonemap, v),
+    },
+    OptionSpec {
+        key: "filter",
+        kind: ValueKind::Name(&["box", "point"]),
+        unit: "",
+        doc: "Samples spread over each pixel's square (box), or all through its centre (point).",
+        default_doc: None,
+        get: |s| OptionValue::Text(s.filter.name().into()),
+        set: |s, v| set_named(&mut s.filter, v),
+    },
+    OptionSpec {
+        key: "cull_lights",
+        kind: ValueKind::Bool,
+        unit: "",
+        doc: "Skip lights whose finite range ends before a point.",
+        default_doc: None,
+        get: |s| OptionValue::Bool(s.cull_lights),
+        set: |s, v| s.cull_lights = v.bool(),
+    },
+    OptionSpec {
+        key: "adaptive",
+        kind: ValueKind::Bool,
+        unit: "",
+        doc: "Spread the samples over the pixels by their noise, spp a pixel on average.",
+        default_doc: None,
+        get: |s| OptionValue::Bool(s.adaptive),
+        set: |s, v| s.adaptive = v.bool(),
+    },
+];
+
+impl RenderSettings {
+    /// Sets setting `key` to `value`, checked by its declaration; None when
+    /// there is no such setting.
+    pub fn set(&mut self, key: &str, value: &OptionValue) -> Option<Result<(), crate::options::OptionError>> {
+        crate::options::find(RENDER_SETTINGS, key).map(|o| o.apply(self, value))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn each_setting_reads_back_what_it_was_set_to() {
+        for spec in RENDER_SETTINGS {
+            let value = match spec.kind {
+                ValueKind::Bool => OptionValue::Bool((spec.get)(&RenderSettings::default()) != OptionValue::Bool(true)),
+                ValueKind::Count { min, .. } => OptionValue::Int(min as i128 + 3),
+                ValueKind::Number(_) => OptionValue::Float(0.375),
+                ValueKind::Colour => OptionValue::List(vec![0.25, 0.5, 0.75]),
+                ValueKind::Name(names) => OptionValue::Text(names[names.len() - 1].into()),
+            };
+            let mut s = RenderSettings::default();
+            spec.apply(&mut s, &value).unwrap_or_else(|e| panic!("{}: {e}", spec.key));
+            assert_eq!((spec.get)(&s), value, "{}", spec.key);
+            assert_ne!(s, RenderSettings::default(), "{} changed nothing", spec.key);
+        }
+    }
+
+    #[test]
+    fn every_listed_name_is_known_to_its_type() {
+        for spec in RENDER_SETTINGS {
+            if let ValueKind::Name(names) = spec.kind {
+                for name in names {
+                    let mut s = RenderSettings::default();
+                    spec.apply(&mut s, &OptionValue::Text((*name).into())).unwrap();
+                    assert_eq!((spec.get)(&s), OptionValue::Text((*name).into()));
+                }
+                assert!(spec.apply(&mut RenderSettings::default(), &OptionValue::Text("nonesuch".into())).is_err());
+            }
+        }
+    }
+}
