@@ -1,4 +1,4 @@
-//! Issue 20's cases for the `airlight` command, as a careless or hostile
+//! The hostile-input cases for the `airlight` command, as a careless or hostile
 //! user meets them: outputs that would replace inputs or each other,
 //! folders that are not there, sizes that do not fit, broken pixels and
 //! pipes, values that make a run endless, scenes that can only be black.

@@ -82,13 +82,14 @@ fn python_package_builds_installs_and_passes_its_tests() {
     );
 
     // The wheel, as `maturin build` makes it for `pip install`, in a Cargo
-    // target folder of its own (this test's Cargo holds the other).
+    // target folder of its own (this test's Cargo holds the other), with
+    // the workspace's `wheel-test` profile: release's, but quicker to build.
     let wheels = work.join("wheels");
     let _ = std::fs::remove_dir_all(&wheels);
     run(
         "maturin build",
         Command::new(bin.join("maturin"))
-            .args(["build", "--release", "--quiet", "--manifest-path"])
+            .args(["build", "--profile", "wheel-test", "--quiet", "--manifest-path"])
             .arg(crate_dir.join("Cargo.toml"))
             .arg("--interpreter")
             .arg(bin.join("python"))

@@ -1,6 +1,6 @@
 //! The `airlight` Python module: scenes from files, text or dicts, rendered
 //! into NumPy arrays, and the CLI's image comparison. Built with maturin
-//! (pyproject.toml); the API is documented in README.md and airlight.pyi.
+//! (pyproject.toml); the API is documented in docs/python.md and airlight.pyi.
 
 mod dict;
 mod errors;

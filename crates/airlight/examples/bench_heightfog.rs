@@ -1,4 +1,4 @@
-//! The path tracer in exponential height fog (issue 15), on one thread.
+//! The path tracer in exponential height fog, on one thread.
 //!
 //! `cargo run --release -p airlight --example bench_heightfog [-- SCENE PATH_SPP DEPTH8_SPP [REF.exr [REF_SPP]]]`
 //! (defaults scenes/heightfog_point.toml, 256, 256, no reference, 65536)

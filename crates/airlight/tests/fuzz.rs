@@ -258,7 +258,7 @@ fn mutated_scenes_and_meshes_never_panic_and_errors_name_file_and_line() {
 }
 
 #[test]
-#[ignore = "a million inputs: run by hand (README, BENCHMARKS.md)"]
+#[ignore = "a million inputs: run by hand (docs/developing.md, BENCHMARKS.md)"]
 fn a_million_mutated_scenes() {
     fuzz_scenes(count(1_000_000));
 }
@@ -356,7 +356,7 @@ fn mutated_exr_files_never_panic_and_errors_name_the_file() {
 }
 
 #[test]
-#[ignore = "a million inputs: run by hand (README, BENCHMARKS.md)"]
+#[ignore = "a million inputs: run by hand (docs/developing.md, BENCHMARKS.md)"]
 fn a_million_mutated_exr_files() {
     fuzz_exrs(count(1_000_000));
 }

@@ -1,4 +1,4 @@
-//! Issue 20's cases for the library: values whose f32 arithmetic would
+//! The hostile-input cases for the library: values whose f32 arithmetic would
 //! overflow or vanish, files a scene may not read, sizes that do not fit.
 //! Each is refused with a message that names the real limit, or renders
 //! right; none panics.

@@ -75,7 +75,7 @@ fn height_fog_free_flights_follow_the_closed_form_distribution() {
     }
 }
 
-/// A light in open height fog (base −1, falloff 0.8, as issue 15's
+/// A light in open height fog (base −1, falloff 0.8, as the height-fog
 /// benchmark) seen from `camera`, 24×24 pixels through their centres.
 fn open_fog(medium: Medium, light: Light, camera: Camera, spp: u32) -> Scene {
     fog_scenes::fog_scene((24, 3, 20.0), medium, light, camera, spp)

@@ -1,5 +1,5 @@
 //! `airlight view`: fly through a scene and move its lights while the
-//! radiosity bounce light follows (issue 9).
+//! radiosity bounce light follows.
 //!
 //! One frame loop ([`engine::Engine`]) serves two drivers: the window
 //! ([`window`], behind the `viewer` cargo feature, minifb on X11), where
@@ -47,7 +47,7 @@ pub struct ViewArgs {
     /// Headless: frames to run.
     #[arg(long, default_value_t = 60, requires = "headless", value_parser = clap::value_parser!(u32).range(1..=crate::preflight::MAX_FRAMES as i64))]
     frames: u32,
-    /// Headless: the scripted camera and light path (TOML; see README, "Viewer").
+    /// Headless: the scripted camera and light path (TOML; see docs/guide/viewer.md).
     #[arg(long, value_name = "CAMERA.toml", requires = "headless")]
     path: Option<PathBuf>,
     /// Headless: write every frame as DIR/frame_0000.exr and .png. Window:

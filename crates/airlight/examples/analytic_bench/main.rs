@@ -1,5 +1,5 @@
 //! Equal-error timing of the analytic integrator against ray marching
-//! (issue 4's benchmark), against an independent converged reference.
+//! (the analytic integrator's benchmark), against an independent converged reference.
 //!
 //! For each scene, at 1 sample per pixel (every integrator traces the same
 //! camera ray in a pixel and shades the surface the same way, so the error is

@@ -1,4 +1,4 @@
-//! Closed-form single-scatter airlight (issue 4), after Packard 2004 (the
+//! Closed-form single-scatter airlight, after Packard 2004 (the
 //! seed: Packard, "Efficient Rendering of Glowing Lights", 2004) and Sun, Ramamoorthi, Narasimhan
 //! and Nayar 2005.
 //!
