@@ -44,7 +44,7 @@ use airlight::prelude::*;
 use airlight::render::accumulate;
 use airlight::scene::PixelFilter;
 
-const DEFAULT_SCENES: u64 = 200;
+const DEFAULT_SCENES: u64 = 60;
 const SIZE: u32 = 6;
 /// Radiosity's patches: coarse, for speed (rooms of 8 units, objects of 0.2
 /// to 2).
