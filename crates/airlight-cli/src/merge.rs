@@ -1,8 +1,9 @@
 //! `airlight merge`: partial renders (from `render --shard/--tile`) added up
 //! into the image one render of all the samples gives, bit for bit.
 
+use crate::outputs::Output;
 use airlight::film::partial::{self, Partial};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 #[derive(clap::Args)]
 pub struct MergeArgs {
@@ -33,6 +34,13 @@ pub fn merge(args: MergeArgs) -> Result<(), String> {
     {
         return Err(format!("cannot write `{}`: the variance is written as .exr", v.display()));
     }
+    // Every output checked against the parts and each other, and its
+    // folder, before any part is read.
+    let outputs: Vec<Output> = args.output.iter().map(|path| Output { option: "-o", path }).collect();
+    let variance = args.variance.iter().map(|path| Output { option: "--variance", path });
+    let outputs: Vec<Output> = outputs.into_iter().chain(variance).collect();
+    let inputs: Vec<&Path> = args.parts.iter().map(PathBuf::as_path).collect();
+    crate::outputs::check(&outputs, &inputs)?;
     let mut parts = Vec::with_capacity(args.parts.len());
     for path in &args.parts {
         let part = Partial::read(path).map_err(|why| format!("{}: {why}", path.display()))?;

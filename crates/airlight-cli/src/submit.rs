@@ -96,11 +96,33 @@ pub fn slurm(args: SlurmArgs) -> Result<(), String> {
     }
     check.extend(["-o".into(), "check.exr".into()]);
     let parsed = RenderCommand::try_parse_from(&check).map_err(|e| format!("the render options: {e}"))?;
-    prepare(&parsed.args)?;
+    let (file, _, _) = prepare(&parsed.args)?;
+    // The merged images, checked now rather than when the merge runs: each
+    // a .png or .exr, none over the scene, its files or each other.
+    for out in &outputs {
+        if !out
+            .extension()
+            .and_then(|e| e.to_str())
+            .is_some_and(|e| matches!(e.to_ascii_lowercase().as_str(), "png" | "exr"))
+        {
+            return Err(format!("cannot write `{}`: the output must end in .png or .exr", out.display()));
+        }
+    }
+    crate::outputs::check_render(Some(&scene), file.scene.files(), &outputs, None, args.frames)?;
 
+    check_sbatch_values(&args)?;
     let work = work_folder(&outputs[0]);
     let (parts, logs) = (work.join("parts"), work.join("logs"));
+    check_log_folder(&logs)?;
     for dir in [&work, &parts, &logs] {
+        // A folder that is a symbolic link would put the scripts and parts
+        // wherever it points.
+        if std::fs::symlink_metadata(dir).is_ok_and(|m| m.file_type().is_symlink()) {
+            return Err(format!(
+                "`{}` is a symbolic link: submit writes its work folder only as a real folder",
+                dir.display()
+            ));
+        }
         std::fs::create_dir_all(dir).map_err(|e| format!("cannot create `{}`: {e}", dir.display()))?;
     }
     let tasks = args.shards as u64 * args.tiles as u64 * args.frames.unwrap_or(1) as u64;
@@ -150,10 +172,52 @@ fn quote(s: &str) -> String {
     format!("'{}'", s.replace('\'', r"'\''"))
 }
 
+/// Refuses a partition or time limit that could not stand alone on an
+/// `#SBATCH` line: sbatch reads those lines itself, and a line break in a
+/// value would start a shell command of its own.
+fn check_sbatch_values(args: &SlurmArgs) -> Result<(), String> {
+    let check = |option: &str, value: &Option<String>, allowed: &dyn Fn(char) -> bool, form: &str| match value {
+        Some(v) if v.is_empty() || !v.chars().all(allowed) => Err(format!("--{option} {v:?}: expected {form}")),
+        _ => Ok(()),
+    };
+    let partition = |c: char| c.is_ascii_alphanumeric() || "_-.,".contains(c);
+    check(
+        "partition",
+        &args.partition,
+        &partition,
+        "a partition name (letters, digits, `_`, `-`, `.`; `,` between names)",
+    )?;
+    let time = |c: char| c.is_ascii_digit() || ":-".contains(c);
+    check("time", &args.time, &time, "a time limit in Slurm's form (minutes, M:S, H:M:S, D-H, D-H:M or D-H:M:S)")
+}
+
+/// Refuses a log folder that an `#SBATCH --output=` line could not hold
+/// as it is: sbatch splits those lines at white space and reads quotes and
+/// backslashes itself, and a line break would end the line. (`%`, Slurm's
+/// file-name patterns, is escaped as `%%` instead.)
+fn check_log_folder(logs: &Path) -> Result<(), String> {
+    let text = logs.to_str().ok_or_else(|| format!("`{}` is not UTF-8: job scripts cannot name it", logs.display()))?;
+    match text.chars().find(|c| c.is_whitespace() || c.is_control() || "\"'\\`$".contains(*c)) {
+        Some(c) => Err(format!(
+            "the work folder `{}` holds {c:?}, which an #SBATCH line cannot hold: give an output in a folder \
+             whose path has no white space, quotes, backslashes, `$` or backticks",
+            logs.display()
+        )),
+        None => Ok(()),
+    }
+}
+
+/// A log file's path for an `#SBATCH --output=` line: `%` doubled, since
+/// Slurm reads `%A`, `%a`, `%j` … as patterns (`pattern` adds its own).
+fn log_path(logs: &Path, pattern: &str) -> String {
+    format!("{}/{pattern}", logs.display().to_string().replace('%', "%%"))
+}
+
 /// The #SBATCH lines every job shares (so that a task run again alone with
-/// `sbatch --array=K render.sh` gets them too).
-fn sbatch_lines(args: &SlurmArgs, name: &str, log: &Path) -> String {
-    let mut s = format!("#SBATCH --job-name={name}\n#SBATCH --output={}\n", log.display());
+/// `sbatch --array=K render.sh` gets them too); every value was checked
+/// ([`check_sbatch_values`], [`check_log_folder`]).
+fn sbatch_lines(args: &SlurmArgs, name: &str, log: &str) -> String {
+    let mut s = format!("#SBATCH --job-name={name}\n#SBATCH --output={log}\n");
     if let Some(p) = &args.partition {
         let _ = writeln!(s, "#SBATCH --partition={p}");
     }
@@ -167,7 +231,7 @@ fn sbatch_lines(args: &SlurmArgs, name: &str, log: &Path) -> String {
 fn render_sh(args: &SlurmArgs, exe: &Path, scene: &Path, parts: &Path, logs: &Path) -> String {
     let (n, m) = (args.shards, args.tiles);
     let mut s = String::from("#!/bin/bash\n");
-    s += &sbatch_lines(args, "airlight-render", &logs.join("render-%A_%a.log"));
+    s += &sbatch_lines(args, "airlight-render", &log_path(logs, "render-%A_%a.log"));
     let _ = writeln!(s, "#SBATCH --cpus-per-task={}", args.cpus_per_task);
     s += "# Task K renders shard K % N, tile (K / N) % M, frame K / (N M).\n";
     s += "set -euo pipefail\n";
@@ -210,7 +274,7 @@ fn part_files(args: &SlurmArgs, parts: &Path, frame: Option<u32>) -> Vec<PathBuf
 /// The merge job's script: one `airlight merge` per frame, naming every part.
 fn merge_sh(args: &SlurmArgs, exe: &Path, outputs: &[PathBuf], parts: &Path, logs: &Path) -> String {
     let mut s = String::from("#!/bin/bash\n");
-    s += &sbatch_lines(args, "airlight-merge", &logs.join("merge-%j.log"));
+    s += &sbatch_lines(args, "airlight-merge", &log_path(logs, "merge-%j.log"));
     s += "set -euo pipefail\n";
     let frames: Vec<Option<u32>> = match args.frames {
         Some(f) => (0..f).map(Some).collect(),
@@ -231,11 +295,17 @@ fn merge_sh(args: &SlurmArgs, exe: &Path, outputs: &[PathBuf], parts: &Path, log
     s
 }
 
+/// Writes a job script whole, executable, never through a symbolic link
+/// at `path` (the link is replaced; what it pointed to is untouched).
 fn write_script(path: &Path, text: &str) -> Result<(), String> {
+    use std::io::Write;
     use std::os::unix::fs::PermissionsExt;
-    std::fs::write(path, text)
-        .and_then(|_| std::fs::set_permissions(path, std::fs::Permissions::from_mode(0o755)))
-        .map_err(|e| format!("cannot write `{}`: {e}", path.display()))
+    airlight::film::write_atomically_with(path, |file| {
+        file.write_all(text.as_bytes())?;
+        // On the open file: a mode set by path would follow a link.
+        file.set_permissions(std::fs::Permissions::from_mode(0o755))
+    })
+    .map_err(|e| format!("cannot write `{}`: {e}", path.display()))
 }
 
 /// Submits `script` with `options`; the job id.

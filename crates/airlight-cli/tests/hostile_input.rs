@@ -243,6 +243,18 @@ fn sizes_that_do_not_fit_in_memory_are_refused_with_size_and_limit() {
 }
 
 #[test]
+fn a_memory_limit_that_is_not_a_size_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    small_scene(d, "s.toml");
+    for value in ["abc", "-1", "1P", "NaN", "", "12 apples"] {
+        let out = airlight_env(d, &["info", "s.toml"], &[("AIRLIGHT_MEMORY_LIMIT", value)]);
+        refused(&out, &format!("AIRLIGHT_MEMORY_LIMIT={value:?} is not a size"));
+    }
+    assert!(airlight_env(d, &["info", "s.toml"], &[("AIRLIGHT_MEMORY_LIMIT", "512M")]).status.success());
+}
+
+#[test]
 fn bounds_name_the_real_limit() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();

@@ -7,6 +7,7 @@ mod errors;
 mod options;
 mod render;
 mod scene;
+mod shared;
 
 use airlight::scene::AssetPath;
 use errors::{Origin, guard};
@@ -109,6 +110,18 @@ fn image(a: &PyArrayLikeDyn<'_, f32, AllowTypeChange>, what: &str) -> PyResult<a
         )));
     }
     let (h, w) = (shape[0], shape[1]);
+    // Checked before the array is copied into a standard layout: a
+    // zero-stride array claims any size in a few bytes.
+    let side = airlight::film::MAX_IMAGE_SIDE as usize;
+    if w > side || h > side || (w as u64) * (h as u64) > airlight::film::MAX_PIXELS {
+        return Err(PyValueError::new_err(format!(
+            "{what} is {w}×{h} pixels; an image has at most {side} on a side and {} in all",
+            airlight::film::MAX_PIXELS
+        )));
+    }
+    let bytes = (w * h) as u64 * (3 * 4 + size_of::<airlight::Rgb>() as u64);
+    airlight::memory::check(format!("{what} ({w}×{h} pixels)"), bytes)
+        .map_err(|e| pyo3::exceptions::PyMemoryError::new_err(e.to_string()))?;
     let pixels = view
         .as_standard_layout()
         .as_slice()

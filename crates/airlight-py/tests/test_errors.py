@@ -96,6 +96,23 @@ def test_bad_dicts_raise_the_file_message_with_the_line_as_toml():
         airlight.Scene({"camera": {"fov": None}})
 
 
+def test_hostile_arrays_and_nesting_raise_instead_of_crashing(tmp_path):
+    # A 70000² image in 12 bytes (every stride 0): refused before it is
+    # copied, rather than aborting the interpreter.
+    pixel = np.zeros(3, np.float32)
+    huge = np.lib.stride_tricks.as_strided(pixel, shape=(70000, 70000, 3), strides=(0, 0, 4))
+    with pytest.raises(ValueError, match="is 70000×70000 pixels; an image has at most 65536 on a side"):
+        airlight.save(str(tmp_path / "x.png"), huge)
+    assert not (tmp_path / "x.png").exists()
+    # Dicts nested 30,000 deep: a SceneError, not a stack overflow.
+    deep = inner = {}
+    for _ in range(30000):
+        inner["a"] = {}
+        inner = inner["a"]
+    with pytest.raises(airlight.SceneError, match="nested more than 256 deep"):
+        airlight.Scene({"objects": [deep]})
+
+
 def test_option_errors_are_the_scene_file_messages(cli, tmp_path):
     scene = airlight.loads(GOOD)
     path = tmp_path / "steps.toml"

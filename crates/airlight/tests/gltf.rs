@@ -212,4 +212,22 @@ fn bad_gltf_files_name_the_file_the_json_path_and_the_problem() {
     assert!(e.contains("not a valid glTF file"), "{e}");
     let e = error("not json");
     assert!(e.contains("not a valid glTF file"), "{e}");
+    // A stride shorter than an element (the gltf crate's reader panics on
+    // it) and accessors of a type their use does not allow (it misreads
+    // them) are refused with the specification's rule.
+    let short_stride = gltf_json(None, "", 4)
+        .replace(r#""byteOffset": 0, "byteLength": 96 }"#, r#""byteOffset": 0, "byteLength": 96, "byteStride": 4 }"#);
+    let e = error(&short_stride);
+    assert!(e.contains("POSITION: bufferViews[0].byteStride is 4; its accessors' elements take 12 bytes"), "{e}");
+    let scalar_positions =
+        gltf_json(None, "", 4).replacen(r#""count": 4, "type": "VEC3""#, r#""count": 4, "type": "SCALAR""#, 1);
+    let e = error(&scalar_positions);
+    assert!(e.contains("POSITION: accessors[0] is Scalar of F32; the specification asks for Vec3 of F32"), "{e}");
+    let byte_positions = gltf_json(None, "", 4).replacen(
+        r#""componentType": 5126, "count": 4"#,
+        r#""componentType": 5121, "count": 4"#,
+        1,
+    );
+    let e = error(&byte_positions);
+    assert!(e.contains("POSITION: accessors[0] is Vec3 of U8"), "{e}");
 }

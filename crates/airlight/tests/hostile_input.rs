@@ -197,3 +197,39 @@ fn a_thousand_identical_spheres_render_as_one() {
     assert!(one.mean().x > 0.01);
     assert_eq!(many, one);
 }
+
+#[test]
+fn thousands_of_identical_faces_are_refused_before_the_bvh_is_built() {
+    // A BVH over identical boxes takes time that grows as the square of
+    // their number: 100,000 copies of one face (an 800 KB file) ran for
+    // hours. Past the limit the scene is refused, at once.
+    let dir = tempfile::tempdir().unwrap();
+    let faces = "f 1 2 3\n".repeat(airlight::scene::limits::MAX_EQUAL_BOUNDS + 1);
+    std::fs::write(dir.path().join("same.obj"), format!("v 0 0 0\nv 1 0 0\nv 0 1 0\n{faces}")).unwrap();
+    let e = SceneFile::load(&mesh_scene(dir.path(), "same.obj")).unwrap_err().to_string();
+    assert!(e.contains("4097 surfaces have exactly the same bounds"), "{e}");
+    // At the limit the scene loads.
+    let faces = "f 1 2 3\n".repeat(airlight::scene::limits::MAX_EQUAL_BOUNDS);
+    std::fs::write(dir.path().join("same.obj"), format!("v 0 0 0\nv 1 0 0\nv 0 1 0\n{faces}")).unwrap();
+    assert!(SceneFile::load(&mesh_scene(dir.path(), "same.obj")).is_ok());
+}
+
+#[test]
+fn a_medium_too_thick_for_any_image_is_refused_not_tracked_forever() {
+    // Noise fog is crossed by null collisions: at σs = 10¹⁰ a path never
+    // finished, at 10⁶ it slowed in proportion. Beyond a million mean free
+    // paths across the scene, the scene is refused; below, it renders.
+    let scene = |sigma_s: &str| {
+        format!(
+            "[render]\nwidth = 4\nheight = 3\nspp = 1\nintegrator = \"path\"\n{TAIL}\
+             [medium]\ntype = \"noise\"\nsigma_s = {sigma_s}\nscale = 1\nmin = [-2, -2, -2]\nmax = [2, 2, 2]\n\
+             [[objects]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\nmaterial = \"m\"\n\
+             [[lights]]\ntype = \"point\"\nposition = [0, 3, -3]\nintensity = 10\n"
+        )
+    };
+    for thick in ["1e10", "1e6"] {
+        let e = load(&scene(thick)).unwrap_err();
+        assert!(e.contains("mean free paths across the scene") && e.contains("more than 1e6"), "{thick}: {e}");
+    }
+    assert!(image(&scene("0.5")).mean().x > 0.0);
+}

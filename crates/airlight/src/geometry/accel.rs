@@ -181,6 +181,24 @@ impl GeometryBuilder {
         }
     }
 
+    /// The largest number of primitives that share exactly the same
+    /// bounds (duplicated faces, objects or instances): no BVH can part
+    /// them, and building one over many of them takes time that grows as
+    /// the square of their number.
+    pub fn largest_group_of_equal_bounds(&self) -> usize {
+        let mut keys: Vec<[u32; 6]> = self
+            .records
+            .iter()
+            .map(|r| {
+                let b = r.prim.bounds();
+                let (lo, hi) = (Vec3::from(b.min), Vec3::from(b.max));
+                [lo.x, lo.y, lo.z, hi.x, hi.y, hi.z].map(f32::to_bits)
+            })
+            .collect();
+        keys.sort_unstable();
+        keys.chunk_by(|a, b| a == b).map(<[_]>::len).max().unwrap_or(0)
+    }
+
     /// Builds the BVH and lays the primitives out in its order.
     pub fn build(self) -> Geometry {
         let GeometryBuilder { records, planes, unbounded, triangle_uvs } = self;

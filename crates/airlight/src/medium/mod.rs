@@ -67,6 +67,18 @@ impl Medium {
     }
 
     /// Whether light passes untouched (σt = 0 in every channel).
+    /// The largest density of a medium that tracking crosses with null
+    /// collisions (a grid, noise without a height falloff); None for the
+    /// media whose flights are drawn exactly (homogeneous and height fog),
+    /// where no density makes the work per path grow.
+    pub fn tracked_peak_density(&self) -> Option<f32> {
+        match &self.density {
+            Density::Grid(grid) => Some(grid.max_value()),
+            Density::Noise(noise) if noise.height.is_none() => Some(noise.noise_bound()),
+            _ => None,
+        }
+    }
+
     pub fn is_vacuum(&self) -> bool {
         self.sigma_t() == Rgb::ZERO
     }

@@ -2,7 +2,7 @@
 //! checks a scene file gets.
 
 use super::emitters::Emitters;
-use super::{LightCulling, RenderSettings, Scene, SceneError, build_geometry, default_camera, placed_delta};
+use super::{LightCulling, RenderSettings, Scene, SceneError, default_camera, geometry_of, limits, placed_delta};
 use crate::camera::Camera;
 use crate::geometry::{Geometry, Shape};
 use crate::light::{Keyframes, Light};
@@ -122,8 +122,19 @@ impl SceneBuilder {
             files: Vec::new(),
             notes: Vec::new(),
         };
-        scene.geometry = build_geometry(scene.surfaces());
+        let geometry = geometry_of(scene.surfaces());
+        let same = geometry.largest_group_of_equal_bounds();
+        if same > limits::MAX_EQUAL_BOUNDS {
+            return Err(SceneError::new(format!(
+                "{same} surfaces have exactly the same bounds (duplicated faces, objects or instances); at most {} \
+                 may, since no BVH can part them and building one over them takes time that grows as the square \
+                 of their number",
+                limits::MAX_EQUAL_BOUNDS
+            )));
+        }
+        scene.geometry = geometry.build();
         scene.update_bounds();
+        scene.check_medium_depth().map_err(SceneError::new)?;
         Ok(scene)
     }
 }

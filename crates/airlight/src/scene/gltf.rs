@@ -168,9 +168,14 @@ impl Checker<'_> {
             }
             let positions_accessor =
                 primitive.get(&gltf::Semantic::Positions).ok_or_else(|| format!("{at}: has no POSITION"))?;
-            fits(&positions_accessor, buffers).map_err(|why| format!("{at}: POSITION: {why}"))?;
+            use gltf::accessor::{DataType, Dimensions};
+            typed(&positions_accessor, Dimensions::Vec3, &[DataType::F32])
+                .and_then(|()| fits(&positions_accessor, buffers))
+                .map_err(|why| format!("{at}: POSITION: {why}"))?;
             if let Some(indices) = primitive.indices() {
-                fits(&indices, buffers).map_err(|why| format!("{at}: indices: {why}"))?;
+                typed(&indices, Dimensions::Scalar, &[DataType::U8, DataType::U16, DataType::U32])
+                    .and_then(|()| fits(&indices, buffers))
+                    .map_err(|why| format!("{at}: indices: {why}"))?;
             }
             let reader = primitive.reader(|b| buffers.get(b.index()).map(Vec::as_slice));
             let positions: Vec<Vec3> = reader
@@ -340,7 +345,10 @@ fn texture_coordinates(
     let accessor = primitive
         .get(&gltf::Semantic::TexCoords(set))
         .ok_or_else(|| format!("its material's base-colour texture uses TEXCOORD_{set}, which it does not have"))?;
-    fits(&accessor, buffers).map_err(|why| format!("TEXCOORD_{set}: {why}"))?;
+    use gltf::accessor::{DataType, Dimensions};
+    typed(&accessor, Dimensions::Vec2, &[DataType::F32, DataType::U8, DataType::U16])
+        .and_then(|()| fits(&accessor, buffers))
+        .map_err(|why| format!("TEXCOORD_{set}: {why}"))?;
     let reader = primitive.reader(|b| buffers.get(b.index()).map(Vec::as_slice));
     let uvs: Vec<Vec2> = reader
         .read_tex_coords(set)
@@ -357,13 +365,42 @@ fn texture_coordinates(
     Ok(uvs)
 }
 
+/// Whether an accessor is of a type the glTF specification allows for
+/// what it is read as (the crate's reader would misread another silently).
+fn typed(
+    accessor: &gltf::Accessor,
+    dimensions: gltf::accessor::Dimensions,
+    types: &[gltf::accessor::DataType],
+) -> std::result::Result<(), String> {
+    let (d, t) = (accessor.dimensions(), accessor.data_type());
+    if d != dimensions || !types.contains(&t) {
+        return Err(format!(
+            "accessors[{}] is {d:?} of {t:?}; the specification asks for {dimensions:?} of {}",
+            accessor.index(),
+            types.iter().map(|t| format!("{t:?}")).collect::<Vec<_>>().join(" or ")
+        ));
+    }
+    Ok(())
+}
+
 /// Whether an accessor's bytes lie inside its buffer view and the view
-/// inside its buffer (the crate's reader assumes so).
+/// inside its buffer, and its view's stride holds an element (the crate's
+/// reader assumes so, and panics on a shorter stride).
 fn fits(accessor: &gltf::Accessor, buffers: &[Vec<u8>]) -> std::result::Result<(), String> {
     if accessor.sparse().is_some() {
         return Err("sparse accessors are not read".into());
     }
     let view = accessor.view().ok_or("an accessor without a bufferView")?;
+    if let Some(stride) = view.stride()
+        && (stride < accessor.size() || !(4..=252).contains(&stride) || stride % 4 != 0)
+    {
+        return Err(format!(
+            "bufferViews[{}].byteStride is {stride}; its accessors' elements take {} bytes, and a stride is a \
+             multiple of 4 from 4 to 252 that holds one",
+            view.index(),
+            accessor.size()
+        ));
+    }
     let buffer = buffers.get(view.buffer().index()).map_or(0, Vec::len);
     let view_end = view.offset().checked_add(view.length());
     if view_end.is_none_or(|end| end > buffer) {

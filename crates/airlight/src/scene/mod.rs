@@ -162,8 +162,11 @@ impl Scene {
 
     /// Replaces the medium (None, or a vacuum: no medium). Integrators
     /// built for the scene before must be built again.
-    pub fn set_medium(&mut self, medium: Option<Medium>) {
-        self.medium = medium.filter(|m| !m.is_vacuum());
+    /// Replaces the medium; one too thick for any image to show is refused
+    /// ([`Scene::check_medium_depth`]) and the scene keeps its own.
+    pub fn set_medium(&mut self, medium: Option<Medium>) -> Result<(), String> {
+        let old = std::mem::replace(&mut self.medium, medium.filter(|m| !m.is_vacuum()));
+        self.check_medium_depth().inspect_err(|_| self.medium = old)
     }
 
     pub fn geometry(&self) -> &Geometry {
@@ -263,6 +266,26 @@ impl Scene {
         self.light_paths.iter().any(Option::is_some)
     }
 
+    /// Refuses a medium crossed by null collisions that is more than
+    /// [`limits::MAX_OPTICAL_DEPTH`] mean free paths across the scene: no
+    /// image can show its inside, and tracking through it would take about
+    /// that many steps a path.
+    pub fn check_medium_depth(&self) -> Result<(), String> {
+        let Some(m) = &self.medium else { return Ok(()) };
+        let Some(peak) = m.tracked_peak_density() else { return Ok(()) };
+        let sigma_t = m.sigma_t().max_element();
+        let depth = sigma_t * peak * 2.0 * self.bounds_radius;
+        if depth <= limits::MAX_OPTICAL_DEPTH {
+            return Ok(());
+        }
+        Err(format!(
+            "the medium is {depth:.3e} mean free paths across the scene (σt {sigma_t} × peak density {peak}): more \
+             than {:.0e}, where a free path is below what 32-bit positions resolve and no image can show its \
+             inside; lower sigma_a, sigma_s or the density",
+            limits::MAX_OPTICAL_DEPTH
+        ))
+    }
+
     fn update_bounds(&mut self) {
         (self.bounds_center, self.bounds_radius) = bounding_sphere(&self.geometry, &self.lights, &self.camera);
     }
@@ -296,11 +319,15 @@ fn placed_delta(lights: &[Light]) -> Vec<u32> {
 }
 
 fn build_geometry(surfaces: impl Iterator<Item = Surface>) -> Geometry {
+    geometry_of(surfaces).build()
+}
+
+fn geometry_of(surfaces: impl Iterator<Item = Surface>) -> GeometryBuilder {
     let mut geometry = GeometryBuilder::default();
     for s in surfaces {
         geometry.add(&s.shape, s.material, s.emitter);
     }
-    geometry.build()
+    geometry
 }
 
 /// The camera of a scene that names none.

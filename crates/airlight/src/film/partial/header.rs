@@ -101,7 +101,7 @@ pub(super) fn parse_header(
             "its header's samples {samples:?} or rows {rows:?} lie outside the image's {spp} spp or {height} rows"
         ));
     }
-    if width as u64 * (rows.end - rows.start) > crate::scene::MAX_PIXELS {
+    if width as u64 * (rows.end - rows.start) > crate::film::MAX_PIXELS {
         return Err(format!(
             "its header declares {width}×{} pixels, more than Airlight renders",
             rows.end - rows.start
@@ -110,9 +110,13 @@ pub(super) fn parse_header(
     let frame = match get("frame")?.as_str() {
         "-" => None,
         text => {
-            let bad = || format!("its header's frame `{text}` is not k/n");
+            let bad = || format!("its header's frame `{text}` is not k/n with 0 ≤ k < n");
             let (k, n) = text.split_once('/').ok_or_else(bad)?;
-            Some((k.parse().map_err(|_| bad())?, n.parse().map_err(|_| bad())?))
+            let (k, n): (u32, u32) = (k.parse().map_err(|_| bad())?, n.parse().map_err(|_| bad())?);
+            if k >= n {
+                return Err(bad());
+            }
+            Some((k, n))
         }
     };
     let exposure = get("exposure")?
