@@ -32,7 +32,9 @@ __all__ = [
 _Path = Union[str, "os.PathLike[str]"]
 _Image = npt.NDArray[np.float32]
 _ArrayLike = npt.ArrayLike
+# integrators: begin
 _Integrator = Literal["direct", "raymarch", "analytic", "stochastic", "path", "radiosity"]
+# integrators: end
 
 class _Bar(Protocol):
     """What a progress bar must have: tqdm's ``update`` and ``total``."""

@@ -4,7 +4,7 @@
 
 use airlight::aov::{Aov, SurfaceAovs, in_scattered_aov, surface_aovs};
 use airlight::film::Image;
-use airlight::integrator::{Integrator, IntegratorKind};
+use airlight::integrator::Integrator;
 use airlight::scene::Scene;
 use std::ops::Range;
 use std::path::{Path, PathBuf};
@@ -21,25 +21,10 @@ pub fn is_exr(path: &Path) -> bool {
     path.extension().is_some_and(|e| e.eq_ignore_ascii_case("exr"))
 }
 
-/// Refuses AOVs that no output would hold, or a partial render's.
-pub fn check(aovs: &[Aov], outputs: &[PathBuf], partial: bool, integrator: IntegratorKind) -> Result<(), String> {
-    if aovs.is_empty() {
-        return Ok(());
-    }
-    if aovs.contains(&Aov::Inscatter) && !integrator.separates_in_scattering() {
-        let those: Vec<&str> =
-            IntegratorKind::ALL.into_iter().filter(|k| k.separates_in_scattering()).map(|k| k.name()).collect();
-        return Err(format!(
-            "--aov inscatter: the {integrator} integrator does not separate the medium's light; use {}",
-            airlight::options::one_of(&those)
-        ));
-    }
-    if partial {
-        return Err("--aov: a shard or tile is a partial EXR of sums; render the AOVs with the merged image's \
-                    render settings, without --shard and --tile"
-            .into());
-    }
-    if !outputs.iter().any(|o| is_exr(o)) {
+/// Refuses AOVs that no output would hold (the library's render job
+/// checks the rest).
+pub fn check(aovs: &[Aov], outputs: &[PathBuf]) -> Result<(), String> {
+    if !aovs.is_empty() && !outputs.iter().any(|o| is_exr(o)) {
         return Err("--aov: the AOVs are layers of an EXR image: give an output ending in .exr (-o NAME.exr)".into());
     }
     Ok(())

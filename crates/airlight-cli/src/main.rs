@@ -3,27 +3,24 @@
 use airlight::SceneFile;
 use airlight::film::{self, Image};
 use airlight::integrator::IntegratorKind;
-use airlight::render::RenderObserver;
 use clap::{Parser, Subcommand};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 mod aovs;
+mod gi;
+mod load;
 mod merge;
 mod options;
 mod outputs;
 mod plot;
 mod preflight;
 mod progress;
-mod progressive;
 mod render;
 mod study;
 mod submit;
 mod timing;
 mod view;
-
-/// The built-in demo scene: spheres on a checker floor under a spot light in fog.
-const DEMO_SCENE: &str = include_str!("../../../scenes/demo.toml");
 
 #[derive(Parser)]
 #[command(name = "airlight", version, about = "Renders light that you can see: glows, light cones, volumetric shadows")]
@@ -45,7 +42,7 @@ enum Command {
     /// each frame with its lights moved along their keyframes; prints the
     /// compile figures and per-frame milliseconds (median, p95) of
     /// direct + push + gather.
-    Gi(GiArgs),
+    Gi(gi::GiArgs),
     /// Fly through a scene and move its lights in a window (with none: the
     /// built-in Cornell box), or replay a scripted path with --headless.
     View(view::ViewArgs),
@@ -95,26 +92,6 @@ struct AttenuationArgs {
     output: PathBuf,
 }
 
-#[derive(clap::Args)]
-struct GiArgs {
-    /// Scene file (TOML).
-    scene: PathBuf,
-    /// Frames; frame k is at time k/(frames − 1) of the animation.
-    #[arg(long, default_value_t = 60, value_parser = clap::value_parser!(u32).range(1..=preflight::MAX_FRAMES as i64))]
-    frames: u32,
-    /// Write every frame, rendered with the radiosity integrator, as
-    /// DIR/frame_0000.png, … (not timed).
-    #[arg(long, value_name = "DIR")]
-    output_dir: Option<PathBuf>,
-    /// Film settings and the radiosity integrator's options (and, in a
-    /// medium, the march's), overriding the scene's `[render]`.
-    #[command(flatten)]
-    options: options::OptionFlags,
-    /// Worker threads (default: all cores).
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=crate::preflight::MAX_THREADS as i64))]
-    threads: Option<u32>,
-}
-
 fn main() -> ExitCode {
     // Die quietly of SIGPIPE, as command-line tools do, when the reader of
     // our output goes away (`airlight info s.toml | head -1`); Rust ignores
@@ -122,6 +99,11 @@ fn main() -> ExitCode {
     // SAFETY: setting a signal's disposition to the default, before any thread starts.
     unsafe { libc::signal(libc::SIGPIPE, libc::SIG_DFL) };
     let cli = Cli::parse();
+    // A memory limit that cannot be read is refused before any work.
+    if let Err(message) = airlight::memory::limit_var() {
+        eprintln!("error: {message}");
+        return ExitCode::FAILURE;
+    }
     let result = match cli.command {
         Command::Render(args) => render::render(args),
         Command::Merge(args) => merge::merge(args),
@@ -130,7 +112,7 @@ fn main() -> ExitCode {
         Command::Info { scene } => info(&scene),
         Command::Compare { image, reference, map } => compare(&image, &reference, map.as_deref()),
         Command::Attenuation(args) => attenuation(args),
-        Command::Gi(args) => gi(args),
+        Command::Gi(args) => gi::gi(args),
         Command::View(args) => view::run(args),
     };
     match result {
@@ -142,119 +124,8 @@ fn main() -> ExitCode {
     }
 }
 
-/// The scene file at `path`, or the built-in demo scene.
-fn load(path: Option<&Path>) -> Result<SceneFile, String> {
-    match path {
-        Some(path) => SceneFile::load_with(path, &airlight::scene::AssetPath::from_env()).map_err(|e| e.to_string()),
-        None => SceneFile::from_toml_str(DEMO_SCENE, None).map_err(|e| format!("built-in demo scene: {e}")),
-    }
-}
-
-fn gi(args: GiArgs) -> Result<(), String> {
-    use airlight::integrator::{Integrator, RadiosityIntegrator};
-    use airlight::render::{frame_time, render, set_time};
-    let SceneFile { mut scene, integrator: mut desc } = load(Some(&args.scene))?;
-    // Every option but the radiosity integrator's (and its march's) would
-    // be ignored here: refuse it rather than let it pass unheard.
-    for (key, _) in &args.options.given {
-        if let Some(o) = airlight::integrator::IntegratorDesc::option(key)
-            && !o.takes.contains(&IntegratorKind::Radiosity)
-        {
-            let takes: Vec<&str> = o.takes.iter().map(|k| k.name()).collect();
-            return Err(format!(
-                "{}: `gi` renders with radiosity, which does not read this option (it is of {})",
-                airlight::options::flag(key),
-                takes.join(", ")
-            ));
-        }
-    }
-    let mut settings = scene.settings().clone();
-    args.options.apply(&mut settings, &mut desc)?;
-    *scene.settings_mut() = settings;
-    if let Some(dir) = &args.output_dir {
-        outputs::check_folder("--output-dir", dir)?;
-        let film = if scene.settings().adaptive {
-            airlight::memory::RenderFilm::Adaptive
-        } else {
-            airlight::memory::RenderFilm::Image
-        };
-        preflight::render_memory(&scene, film)?;
-    }
-    preflight::warn_if_dark(&scene, true);
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(args.threads.unwrap_or(0) as usize)
-        .build()
-        .map_err(|e| format!("cannot start worker threads: {e}"))?;
-    pool.install(|| {
-        let mut integrator = RadiosityIntegrator::new(&scene, desc.radiosity, desc.raymarch)
-            .map_err(|e| format!("{}: {e}", args.scene.display()))?;
-        let solution = &integrator.solution;
-        let (params, st) = (solution.params(), solution.stats());
-        let ms = |d: std::time::Duration| d.as_secs_f64() * 1e3;
-        println!("scene: {}", args.scene.display());
-        println!(
-            "threads: {}, patch_size: {}, link_threshold: {}, receiver_share: {}, bounces: {}",
-            rayon::current_num_threads(),
-            params.patch_size,
-            params.link_threshold,
-            params.receiver_share,
-            desc.radiosity.bounces
-        );
-        println!("patches: {} ({} sides that see nothing dropped), clusters: {}", st.patches, st.dropped, st.clusters);
-        println!(
-            "links: {} ({} patch to patch, {} with a cluster; {:.1} per patch)",
-            st.links,
-            st.links_patch_to_patch,
-            st.links - st.links_patch_to_patch,
-            st.links as f64 / st.patches.max(1) as f64
-        );
-        println!("memory: {:.2} MiB", st.bytes as f64 / (1u64 << 20) as f64);
-        println!(
-            "compile: {:.1} ms (cut {:.1}, cull {:.1}, cluster {:.1}, link {:.1})",
-            ms(st.total),
-            ms(st.cut),
-            ms(st.cull),
-            ms(st.cluster),
-            ms(st.link)
-        );
-        let mut frames = Vec::with_capacity(args.frames as usize);
-        let forecast = preflight::Forecast::new(args.frames as u64, format!("{} frames", args.frames), false);
-        for k in 0..args.frames {
-            if let Some(warning) = forecast.advance(1) {
-                eprintln!("{warning}");
-            }
-            set_time(&mut scene, &mut integrator, frame_time(k, args.frames)).map_err(|e| e.to_string())?;
-            frames.push(integrator.last_update);
-            if let Some(dir) = &args.output_dir {
-                let image = render(&scene, &integrator as &dyn Integrator, &RenderObserver::none());
-                let out = dir.join(format!("frame_{k:04}.png"));
-                let s = scene.settings();
-                image
-                    .save_with(&out, s.exposure, s.tonemap)
-                    .map_err(|e| format!("cannot write `{}`: {e}", out.display()))?;
-            }
-        }
-        let stat = |f: &dyn Fn(&airlight::radiosity::FrameTimes) -> std::time::Duration| {
-            let mut v: Vec<f64> = frames.iter().map(|t| ms(f(t))).collect();
-            v.sort_by(f64::total_cmp);
-            let at = |q: f64| v[((v.len() - 1) as f64 * q).round() as usize];
-            (at(0.5), at(0.95))
-        };
-        let (med, p95) = stat(&|t| t.total());
-        println!("per frame (direct + push + gather), {} frames: median {med:.3} ms, p95 {p95:.3} ms", frames.len());
-        let (d, _) = stat(&|t| t.direct);
-        let (p, _) = stat(&|t| t.push);
-        let (g, _) = stat(&|t| t.gather);
-        println!("  median direct {d:.3} ms, push {p:.3} ms, gather {g:.3} ms");
-        if let Some(dir) = &args.output_dir {
-            println!("frames written to {}", dir.display());
-        }
-        Ok(())
-    })
-}
-
 fn info(path: &Path) -> Result<(), String> {
-    let SceneFile { scene, integrator } = load(Some(path))?;
+    let SceneFile { scene, integrator } = load::load(Some(path))?;
     preflight::warn_if_dark(&scene, integrator.kind != IntegratorKind::Direct);
     let s = scene.settings();
     println!("scene: {}", path.display());

@@ -5,19 +5,48 @@
 //! option's doc line; its value is checked by the option's own check as
 //! clap reads it.
 
-use airlight::integrator::{INTEGRATOR_OPTIONS, IntegratorDesc};
+use airlight::integrator::{INTEGRATOR_OPTIONS, IntegratorDesc, IntegratorKind, IntegratorOption};
 use airlight::options::{OptionError, OptionSpec, OptionValue, ValueKind, flag};
 use airlight::scene::{RENDER_SETTINGS, RenderSettings};
 use clap::builder::PossibleValuesParser;
 use clap::{Arg, ArgAction, ArgMatches, Command};
 
-/// The options given on the command line, in the declarations' order.
-#[derive(Clone, Debug, Default)]
-pub struct OptionFlags {
-    pub given: Vec<(&'static str, OptionValue)>,
+/// Which integrator options a command takes as flags (every film setting
+/// is a flag of each).
+pub trait FlagSet: Clone + Send + Sync + 'static {
+    fn takes(option: &IntegratorOption) -> bool;
 }
 
-impl OptionFlags {
+/// Every integrator option (`render`).
+#[derive(Clone, Debug, Default)]
+pub struct EveryOption;
+
+impl FlagSet for EveryOption {
+    fn takes(_: &IntegratorOption) -> bool {
+        true
+    }
+}
+
+/// The options that a radiosity render reads (`gi`, which renders with
+/// radiosity alone, so not `integrator` either): a flag it would not hear is
+/// no flag of it.
+#[derive(Clone, Debug, Default)]
+pub struct RadiosityFlags;
+
+impl FlagSet for RadiosityFlags {
+    fn takes(option: &IntegratorOption) -> bool {
+        option.spec.key != "integrator" && option.takes.contains(&IntegratorKind::Radiosity)
+    }
+}
+
+/// The options given on the command line, in the declarations' order.
+#[derive(Clone, Debug, Default)]
+pub struct OptionFlags<S: FlagSet = EveryOption> {
+    pub given: Vec<(&'static str, OptionValue)>,
+    set: std::marker::PhantomData<S>,
+}
+
+impl<S: FlagSet> OptionFlags<S> {
     /// Applies the film settings given to `settings` and the integrator
     /// options given to `integrator`. The values were checked as they were
     /// parsed; names and cross-checks may still fail, with the flag named.
@@ -61,9 +90,9 @@ fn flag_spec<T: Default>(o: &OptionSpec<T>, takes: Option<String>) -> FlagSpec {
     FlagSpec { key: o.key, kind: o.kind, help }
 }
 
-fn flag_specs() -> Vec<(FlagSpec, &'static str)> {
+fn flag_specs<S: FlagSet>() -> Vec<(FlagSpec, &'static str)> {
     let film = RENDER_SETTINGS.iter().map(|o| (flag_spec(o, None), "Film and sampling"));
-    let integrators = INTEGRATOR_OPTIONS.iter().map(|o| {
+    let integrators = INTEGRATOR_OPTIONS.iter().filter(|o| S::takes(o)).map(|o| {
         let takes = (o.spec.key != "integrator").then(|| {
             let names: Vec<&str> = o.takes.iter().map(|k| k.name()).collect();
             names.join(", ")
@@ -77,9 +106,9 @@ fn no_flag(key: &'static str) -> String {
     format!("no-{}", key.replace('_', "-"))
 }
 
-impl clap::Args for OptionFlags {
+impl<S: FlagSet> clap::Args for OptionFlags<S> {
     fn augment_args(mut cmd: Command) -> Command {
-        for (spec, heading) in flag_specs() {
+        for (spec, heading) in flag_specs::<S>() {
             let (key, kind) = (spec.key, spec.kind);
             let long = key.replace('_', "-");
             let check = move |s: &str| kind.check(key, &OptionValue::parse_word(s)).map(|_| OptionValue::parse_word(s));
@@ -123,15 +152,15 @@ impl clap::Args for OptionFlags {
     }
 }
 
-impl clap::FromArgMatches for OptionFlags {
+impl<S: FlagSet> clap::FromArgMatches for OptionFlags<S> {
     fn from_arg_matches(matches: &ArgMatches) -> Result<Self, clap::Error> {
-        let mut flags = OptionFlags::default();
+        let mut flags = OptionFlags { given: Vec::new(), set: std::marker::PhantomData };
         flags.update_from_arg_matches(matches)?;
         Ok(flags)
     }
 
     fn update_from_arg_matches(&mut self, matches: &ArgMatches) -> Result<(), clap::Error> {
-        for (spec, _) in flag_specs() {
+        for (spec, _) in flag_specs::<S>() {
             let key = spec.key;
             let value = match spec.kind {
                 ValueKind::Name(_) => matches.get_one::<String>(key).map(|s| OptionValue::Text(s.clone())),
@@ -205,5 +234,21 @@ mod tests {
         let e = parse(&["--reuse=maybe"]).unwrap_err();
         assert!(e.contains("--reuse must be true or false"), "{e}");
         assert!(parse(&["--reuse", "--no-reuse"]).is_err());
+    }
+
+    #[test]
+    fn a_radiosity_command_has_no_flag_radiosity_does_not_read() {
+        #[derive(Parser)]
+        struct Gi {
+            #[command(flatten)]
+            options: OptionFlags<RadiosityFlags>,
+        }
+        let parse = |args: &[&str]| Gi::try_parse_from(std::iter::once("gi").chain(args.iter().copied()));
+        for flag in ["--sampling=mis", "--integrator=path", "--max-depth=3", "--light-steps=4"] {
+            assert!(parse(&[flag]).is_err(), "{flag}");
+        }
+        let gi = parse(&["--bounces=3", "--steps=8", "--spp=2"]).unwrap();
+        let keys: Vec<&str> = gi.options.given.iter().map(|(k, _)| *k).collect();
+        assert_eq!(keys, ["spp", "steps", "bounces"]);
     }
 }

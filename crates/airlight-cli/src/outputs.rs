@@ -134,6 +134,34 @@ pub fn check_folder(option: &str, folder: &Path) -> Result<(), String> {
     Ok(())
 }
 
+/// Checks a folder a command will write the files `names` into (frames):
+/// the folder as [`check_folder`] checks it, and no file it writes may
+/// replace one of the command's `inputs` (a scene or texture named
+/// `frame_0000.png` there).
+pub fn check_in_folder(
+    option: &str,
+    folder: &Path,
+    names: impl Iterator<Item = String>,
+    inputs: &[&Path],
+) -> Result<(), String> {
+    check_folder(option, folder)?;
+    let resolved = folder.canonicalize().map_err(|e| format!("{option} `{}`: {e}", folder.display()))?;
+    let mut input_ids = std::collections::HashSet::new();
+    for input in inputs {
+        input_ids.extend(identity(input).ok());
+        input_ids.extend(input.canonicalize().ok());
+    }
+    for name in names {
+        if input_ids.contains(&resolved.join(&name)) {
+            return Err(format!(
+                "{option} `{}`: its `{name}` would replace an input of this command: choose another folder",
+                folder.display()
+            ));
+        }
+    }
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -4,7 +4,7 @@
 
 use airlight::Image;
 use airlight::integrator::Integrator;
-use airlight::memory::RenderFilm;
+use airlight::render::RenderMode;
 use airlight::scene::Scene;
 use std::sync::Mutex;
 use std::time::{Duration, Instant};
@@ -13,17 +13,12 @@ use std::time::{Duration, Instant};
 /// --headless --frames`): 2²⁰, about 10 hours of 30 fps video.
 pub const MAX_FRAMES: u32 = 1 << 20;
 
-/// Most worker threads (`--threads`): spawning tens of thousands takes
-/// minutes before any work starts.
-pub const MAX_THREADS: u32 = 4096;
+/// Most worker threads (`--threads`), as the library's render job allows.
+pub const MAX_THREADS: u32 = airlight::render::MAX_THREADS;
 
 /// Refuses a render whose image and sums would not fit in memory.
-pub fn render_memory(scene: &Scene, film: RenderFilm) -> Result<(), String> {
-    let s = scene.settings();
-    let pixels = s.width as u64 * s.height as u64;
-    let what = format!("a {}×{} render", s.width, s.height);
-    airlight::memory::check(what, airlight::memory::render_bytes(pixels, film))
-        .map_err(|e| format!("{e}: make the image smaller (--width, --height)"))
+pub fn render_memory(scene: &Scene, mode: RenderMode) -> Result<(), String> {
+    mode.check_memory(scene.settings()).map_err(|e| format!("{e}: make the image smaller (--width, --height)"))
 }
 
 /// Prints a warning when every frame of `scene` will be black, and one for

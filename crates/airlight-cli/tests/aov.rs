@@ -161,6 +161,6 @@ fn the_in_scattered_light_is_a_layer_for_single_scattering_integrators() {
         &[&["render", "s.toml", "--integrator", "path", "--aov", "inscatter", "-o", "p.exr"], &fog[..]].concat(),
     );
     let err = String::from_utf8_lossy(&path.stderr);
-    assert!(err.contains("--aov inscatter: the path integrator does not separate the medium's light"), "{err}");
+    assert!(err.contains("the inscatter AOV: the path integrator does not separate the medium's light"), "{err}");
     assert!(!dir.path().join("p.exr").exists());
 }

@@ -104,7 +104,7 @@ fn shard_and_tile_options_are_checked() {
         (&["--shard", "3/3", "-o", "p.exr"][..], "is not K/N"),
         (&["--shard", "1/7", "-o", "p.exr"][..], "only 6 samples per pixel"),
         (&["--tile", "0/2", "-o", "p.png"][..], "give one `-o PART.exr`"),
-        (&["--shard", "0/2", "--progressive", "-o", "p.exr"][..], "do not go with"),
+        (&["--shard", "0/2", "--progressive", "-o", "p.exr"][..], "does not go with passes"),
     ] {
         let out = airlight(d, &[&["render", &scene], &SIZE[..], extra].concat());
         let stderr = String::from_utf8_lossy(&out.stderr);

@@ -1,13 +1,17 @@
-//! The reference tables of `[render]`'s keys (docs/scene-format.md) and the
-//! Python stubs' keywords of `Scene.render` (airlight.pyi) are made from
-//! the option declarations; these tests fail when either has drifted from
-//! them. `AIRLIGHT_BLESS=1 cargo test --test option_docs` writes them anew.
+//! The references are made from the code, and these tests fail when one
+//! has drifted from it: the tables of `[render]`'s keys in
+//! docs/scene-format.md and the Python stubs' keywords of `Scene.render`
+//! and integrator names (airlight.pyi) from the option declarations and
+//! the integrator kinds; each command's options in docs/cli.md from its
+//! `--help`. `AIRLIGHT_BLESS=1 cargo test --test reference_docs --
+//! --test-threads=1` writes them anew.
 
 use airlight::SceneFile;
-use airlight::integrator::INTEGRATOR_OPTIONS;
+use airlight::integrator::{INTEGRATOR_OPTIONS, IntegratorKind};
 use airlight::options::{NumberRange, OptionSpec, ValueKind};
 use airlight::scene::RENDER_SETTINGS;
 use std::path::{Path, PathBuf};
+use std::process::Command;
 
 fn repository() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
@@ -42,11 +46,7 @@ fn markdown_tables() -> String {
     out += "| key | read by | value | default | meaning |\n|---|---|---|---|---|\n";
     for o in INTEGRATOR_OPTIONS {
         let takes: Vec<&str> = o.takes.iter().map(|k| k.name()).collect();
-        let takes = if takes.len() == airlight::integrator::IntegratorKind::ALL.len() {
-            "all".to_string()
-        } else {
-            takes.join(", ")
-        };
+        let takes = if takes.len() == IntegratorKind::ALL.len() { "all".to_string() } else { takes.join(", ") };
         out += &row(&o.spec, Some(takes));
     }
     out
@@ -102,7 +102,7 @@ fn check_region(file: &Path, begin: &str, end: &str, generated: &str) {
         let line = text.lines().zip(rebuilt.lines()).position(|(a, b)| a != b).map_or(0, |i| i + 1);
         panic!(
             "{} disagrees with the option declarations from line {line}; \
-             run `AIRLIGHT_BLESS=1 cargo test --test option_docs` to write it anew",
+             run `AIRLIGHT_BLESS=1 cargo test --test reference_docs -- --test-threads=1` to write it anew",
             file.display()
         );
     }
@@ -121,10 +121,44 @@ fn the_python_stubs_take_every_declared_option() {
 }
 
 #[test]
+fn the_python_stubs_name_every_integrator() {
+    let file = repository().join("crates/airlight-py/airlight.pyi");
+    let names: Vec<String> = IntegratorKind::NAMES.iter().map(|n| format!("\"{n}\"")).collect();
+    let literal = format!("_Integrator = Literal[{}]\n", names.join(", "));
+    check_region(&file, "# integrators: begin", "# integrators: end", &literal);
+}
+
+#[test]
 fn every_key_of_the_render_table_is_declared_once() {
     let keys: Vec<&str> = SceneFile::render_keys().collect();
     for key in &keys {
         assert_eq!(keys.iter().filter(|k| *k == key).count(), 1, "{key} declared twice");
     }
     assert!(keys.len() >= 20, "{keys:?}");
+}
+
+/// Every command, as its words on the command line.
+const COMMANDS: &[&[&str]] = &[
+    &["render"],
+    &["merge"],
+    &["submit", "slurm"],
+    &["info"],
+    &["compare"],
+    &["study"],
+    &["gi"],
+    &["attenuation"],
+    &["view"],
+];
+
+#[test]
+fn the_cli_reference_holds_each_commands_help() {
+    let file = repository().join("docs/cli.md");
+    for words in COMMANDS {
+        let out = Command::new(env!("CARGO_BIN_EXE_airlight")).args(*words).arg("--help").output().unwrap();
+        assert!(out.status.success(), "{words:?}");
+        let help = String::from_utf8(out.stdout).unwrap();
+        let name = words.join(" ");
+        let block = format!("```text\n{}\n```\n", help.trim_end());
+        check_region(&file, &format!("<!-- help: {name} begin -->"), &format!("<!-- help: {name} end -->"), &block);
+    }
 }

@@ -4,17 +4,16 @@
 //! at most every 0.1 s, to report progress.
 
 use crate::errors::{integrator_error, internal_error, panic_message};
-use crate::scene::{Pose, Shared};
+use crate::shared::{Pose, Shared};
 use airlight::Rgb;
 use airlight::aov::{SurfaceAovs, surface_aovs};
 use airlight::film::PixelSum;
 use airlight::integrator::IntegratorDesc;
-use airlight::render::{RenderObserver, accumulate, render_samples};
+use airlight::render::{RenderJob, RenderMode, RenderObserver, accumulate, render_samples};
 use airlight::scene::RenderSettings;
 use pyo3::exceptions::{PyImportError, PyRuntimeError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use std::ops::Range;
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::{Arc, Condvar, Mutex, MutexGuard, TryLockError};
@@ -35,10 +34,9 @@ pub struct Job {
     pub settings: RenderSettings,
     pub desc: IntegratorDesc,
     pub pose: Pose,
-    pub samples: Range<u64>,
-    pub threads: usize,
-    /// Also the estimated variance of each pixel's mean.
-    pub variance: bool,
+    /// The render's samples, rows, AOVs and threads, checked by the
+    /// library's rules.
+    pub render: RenderJob,
     /// Also the first hits' albedo, normal and depth.
     pub surface: bool,
 }
@@ -83,7 +81,8 @@ impl State {
 /// exception to raise (KeyboardInterrupt on Ctrl-C).
 pub fn run(py: Python<'_>, job: Job, progress: Option<Progress>) -> PyResult<Output> {
     let s = &job.settings;
-    let total = s.width as u64 * s.height as u64 * (job.samples.end - job.samples.start);
+    let samples = &job.render.samples;
+    let total = s.width as u64 * s.height as u64 * (samples.end - samples.start);
     let mut progress = progress.map(|p| Reporter::start(py, p, total)).transpose()?;
     let state = Arc::new(State::default());
     let worker = Arc::clone(&state);
@@ -126,7 +125,7 @@ pub fn run(py: Python<'_>, job: Job, progress: Option<Progress>) -> PyResult<Out
 fn failure(f: Failure) -> PyErr {
     match f {
         Failure::Integrator(message) => integrator_error(message),
-        Failure::Pool(message) => PyRuntimeError::new_err(format!("cannot start worker threads: {message}")),
+        Failure::Pool(message) => PyRuntimeError::new_err(message),
         // Only a cancel the waiting thread asked for stops a render, and it
         // raises its own exception.
         Failure::Cancelled => PyRuntimeError::new_err("the render was cancelled"),
@@ -137,11 +136,7 @@ fn failure(f: Failure) -> PyErr {
 /// The render thread: takes the scene, brings it and its integrator to the
 /// job's pose and settings, and renders.
 fn work(job: &Job, state: &State) -> Result<Output, Failure> {
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(job.threads)
-        .thread_name(|i| format!("airlight-{i}"))
-        .build()
-        .map_err(|e| Failure::Pool(e.to_string()))?;
+    let pool = job.render.thread_pool().map_err(Failure::Pool)?;
     let mut guard = lock(&job.shared, &state.cancel)?;
     // The guard itself may not cross threads; what it guards may.
     let shared: &mut Shared = &mut guard;
@@ -158,18 +153,19 @@ fn work(job: &Job, state: &State) -> Result<Output, Failure> {
     fn flat(pixels: impl Iterator<Item = Rgb>) -> Vec<f32> {
         pixels.flat_map(|p| p.to_array()).collect()
     }
-    let (color, variance) = if job.variance {
+    let samples = &job.render.samples;
+    let (color, variance) = if job.render.variance {
         let rows = 0..job.settings.height;
-        let acc = pool.install(|| accumulate(&shared.scene, integrator, job.samples.clone(), rows, &observer));
+        let acc = pool.install(|| accumulate(&shared.scene, integrator, samples.clone(), rows, &observer));
         let variance = flat(acc.pixels().iter().map(|p| p.variance_of_mean().as_vec3()));
         (flat(acc.pixels().iter().map(PixelSum::mean)), Some(variance))
-    } else if job.settings.adaptive {
+    } else if job.render.mode == RenderMode::Adaptive {
         // Every sample of the render (a shard is refused): spread by noise.
         let image = pool.install(|| airlight::render(&shared.scene, integrator, &observer));
         (flat(image.pixels.into_iter()), None)
     } else {
         // (At most the scene's spp, a u32.)
-        let (first, count) = (job.samples.start, (job.samples.end - job.samples.start) as u32);
+        let (first, count) = (samples.start, (samples.end - samples.start) as u32);
         let image = pool.install(|| render_samples(&shared.scene, integrator, first, count, &observer));
         (flat(image.pixels.into_iter()), None)
     };
@@ -179,7 +175,7 @@ fn work(job: &Job, state: &State) -> Result<Output, Failure> {
     // As `airlight render --aov` computes them: over the camera rays of the
     // render's own samples.
     let surface =
-        job.surface.then(|| pool.install(|| surface_aovs(&shared.scene, integrator.stratified(), job.samples.clone())));
+        job.surface.then(|| pool.install(|| surface_aovs(&shared.scene, integrator.stratified(), samples.clone())));
     Ok(Output { color, variance, surface })
 }
 

@@ -11,12 +11,12 @@
 use crate::errors::{Origin, guard, scene_error};
 use crate::options;
 use crate::render::{self, Job, Output, Progress};
+use crate::shared::Shared;
 use airlight::SceneFile;
 use airlight::aov::Aov;
-use airlight::integrator::{Integrator, IntegratorDesc, IntegratorError, IntegratorKind};
-use airlight::light::Light;
-use airlight::memory::RenderFilm;
-use airlight::scene::{AssetPath, RenderSettings, Scene};
+use airlight::integrator::{IntegratorDesc, IntegratorKind};
+use airlight::render::{MAX_THREADS, RenderRequest};
+use airlight::scene::{AssetPath, RenderSettings};
 use numpy::ndarray::{Array2, Array3};
 use numpy::{PyArray2, PyArray3};
 use pyo3::exceptions::{PyMemoryError, PyUserWarning, PyValueError};
@@ -24,91 +24,6 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
-
-/// Most worker threads a render starts, as `airlight render --threads`
-/// allows: spawning tens of thousands takes minutes before any work starts.
-const MAX_THREADS: i64 = 4096;
-
-/// Where the lights are: None as the file writes them (a still render),
-/// Some(t) at time t of the keyframes.
-pub type Pose = Option<f32>;
-
-/// The Rust scene and its integrator, shared by the scenes `at_time` makes.
-pub struct Shared {
-    pub scene: Scene,
-    /// The lights as the file writes them.
-    base_lights: Vec<Light>,
-    /// The pose the scene's lights are in; None while unknown (a panic
-    /// part way through moving them).
-    pose: Option<Pose>,
-    cache: Option<Cached>,
-}
-
-/// The integrator last built, what it was built from, and the pose it was
-/// last told of (None: unknown).
-struct Cached {
-    desc: IntegratorDesc,
-    /// Radiosity draws its patches' samples with the scene's seed.
-    seed: u64,
-    integrator: Box<dyn Integrator>,
-    pose: Option<Pose>,
-}
-
-impl Shared {
-    fn new(scene: Scene) -> Shared {
-        Shared { base_lights: scene.lights().to_vec(), scene, pose: Some(None), cache: None }
-    }
-
-    /// After a panic while the scene was held: rebuild what it changed.
-    pub fn forget(&mut self) {
-        self.pose = None;
-        self.cache = None;
-    }
-
-    /// Brings the lights to `pose` and the integrator `desc` to them,
-    /// building it if the cached one is of another description or seed.
-    pub fn prepare(&mut self, desc: IntegratorDesc, pose: Pose) -> Result<(), IntegratorError> {
-        let seed = self.scene.settings().seed;
-        if !matches!(&self.cache, Some(c) if c.desc == desc && c.seed == seed) {
-            self.cache = None;
-            // As `airlight render --frames` does: built for the file's
-            // lights, then moved to the frame.
-            self.move_lights(None);
-            let integrator = desc.build(&self.scene)?;
-            self.cache = Some(Cached { desc, seed, integrator, pose: Some(None) });
-        }
-        self.move_lights(pose);
-        let Some(cached) = self.cache.as_mut() else { unreachable!("built above") };
-        if cached.pose != Some(pose) {
-            cached.pose = None;
-            cached.integrator.lights_changed(&self.scene)?;
-            cached.pose = Some(pose);
-        }
-        Ok(())
-    }
-
-    fn move_lights(&mut self, pose: Pose) {
-        if self.pose == Some(pose) {
-            return;
-        }
-        self.pose = None;
-        // From the file's lights each time, so that a frame's lights do not
-        // depend on the frames rendered before it.
-        self.scene.set_lights(&self.base_lights);
-        if let Some(t) = pose {
-            self.scene.at_time(t);
-        }
-        self.pose = Some(pose);
-    }
-
-    /// The integrator [`Shared::prepare`] made ready.
-    pub fn integrator(&self) -> &dyn Integrator {
-        match &self.cache {
-            Some(c) => c.integrator.as_ref(),
-            None => unreachable!("prepare() builds the integrator before a render"),
-        }
-    }
-}
 
 /// A scene's text and where it came from, for `with_lights` and errors.
 pub struct Source {
@@ -405,68 +320,42 @@ impl PyScene {
         options: Option<&Bound<'py, PyDict>>,
     ) -> PyResult<Bound<'py, PyAny>> {
         guard(|| {
+            airlight::memory::limit_var().map_err(PyValueError::new_err)?;
             let given: Vec<(String, Bound<'py, PyAny>)> = match options {
                 Some(o) => o.iter().map(|(k, v)| Ok((k.extract::<String>()?, v))).collect::<PyResult<_>>()?,
                 None => Vec::new(),
             };
             let (settings, desc) = options::apply(&self.settings, self.integrator, integrator, &given)?;
+            // Python's integers as the job's: out of range, the job's own
+            // message with the value as given.
             let threads = match threads {
-                None => 0,
-                Some(n) if (1..=MAX_THREADS).contains(&n) => n as usize,
-                Some(n) => {
-                    return Err(PyValueError::new_err(format!(
-                        "threads must be an integer from 1 to {MAX_THREADS}, got {n}"
-                    )));
-                }
+                None => None,
+                Some(n) => Some(u32::try_from(n).ok().filter(|&n| n >= 1).ok_or_else(|| {
+                    PyValueError::new_err(format!("threads must be an integer from 1 to {MAX_THREADS}, got {n}"))
+                })?),
             };
-            let spp = settings.spp as u64;
-            let samples = match shard {
-                None => 0..spp,
-                Some((k, n)) if !(0 <= k && k < n) => {
+            let shard = match shard {
+                None => None,
+                Some((k, n)) if 0 <= k && k < n && n <= u32::MAX as i64 => Some((k as u32, n as u32)),
+                Some((k, n)) => {
                     return Err(PyValueError::new_err(format!("shard (k, n) needs 0 ≤ k < n, got ({k}, {n})")));
                 }
-                Some((_, n)) if n as u64 > spp => {
-                    return Err(PyValueError::new_err(format!(
-                        "shard (k, {n}): the render has only {spp} samples per pixel, so at most {spp} shards"
-                    )));
-                }
-                Some((k, n)) => airlight::film::partial::piece(spp, k as u64, n as u64),
             };
             let aovs = aov_list(aovs)?;
-            if !aovs.is_empty() && shard.is_some() {
-                return Err(PyValueError::new_err(
-                    "aovs: a shard holds part of the samples; render the AOVs without shard, as \
-                     `airlight render --aov` refuses --shard",
-                ));
-            }
-            let variance = aovs.contains(&Aov::Variance);
-            if settings.adaptive && (shard.is_some() || variance) {
-                return Err(PyValueError::new_err(
-                    "adaptive sampling renders in one go, its counts set by a pilot pass: it does not go with \
-                     shard or the variance AOV, as `airlight render --adaptive` refuses --shard and --variance",
-                ));
-            }
+            let request = RenderRequest { shard, aovs: aovs.clone(), threads, ..Default::default() };
+            let job = request.check(&settings, desc.kind).map_err(PyValueError::new_err)?;
             let surface = aovs.iter().any(|a| matches!(a, Aov::Albedo | Aov::Normal | Aov::Depth));
             // As the CLI does before it renders: an image too large for
             // memory is refused, a scene that can only be black is warned of.
-            let pixels = settings.width as u64 * settings.height as u64;
-            let what = format!("a {}×{} render", settings.width, settings.height);
-            // A variance keeps every pixel's sums to the end, as passes do;
-            // adaptive sampling keeps them through its pilot.
-            let film = if variance {
-                RenderFilm::Progressive { cancellable: false }
-            } else if settings.adaptive {
-                RenderFilm::Adaptive
-            } else {
-                RenderFilm::Image
-            };
-            airlight::memory::check(what, airlight::memory::render_bytes(pixels, film))
+            job.mode
+                .check_memory(&settings)
                 .map_err(|e| PyMemoryError::new_err(format!("{e}: make the image smaller (width=, height=)")))?;
             let sees_medium = desc.kind != IntegratorKind::Direct;
             if let Some(why) = &self.summary.darkness[sees_medium as usize] {
                 let message = std::ffi::CString::new(why.as_str()).unwrap_or_default();
                 PyErr::warn(py, &py.get_type::<PyUserWarning>(), &message, 1)?;
             }
+            let samples = &job.samples;
             let label =
                 format!("{} {}×{} {} spp", desc.kind, settings.width, settings.height, samples.end - samples.start);
             let progress = Progress::from_arg(py, progress, &label)?;
@@ -474,7 +363,7 @@ impl PyScene {
             // A scene without keyframes is the same at every time.
             let pose = self.time.filter(|_| self.summary.animated);
             let shared = Arc::clone(&self.shared);
-            let job = Job { shared, settings, desc, pose, samples, threads, variance, surface };
+            let job = Job { shared, settings, desc, pose, render: job, surface };
             let Output { color, mut variance, mut surface } = render::run(py, job, progress)?;
             let color = array(py, color, w, h)?;
             if aovs.is_empty() {

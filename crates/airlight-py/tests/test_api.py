@@ -80,7 +80,7 @@ def test_aovs_give_named_arrays_beside_the_color(fog):
         fog.render(**SMALL, aovs="colour")
     with pytest.raises(ValueError, match="^aovs: inscatter is not computed from Python yet"):
         fog.render(**SMALL, aovs="depth,inscatter")
-    with pytest.raises(ValueError, match="without shard"):
+    with pytest.raises(ValueError, match="without a shard"):
         fog.render(**SMALL, aovs=True, shard=(0, 2))
 
 

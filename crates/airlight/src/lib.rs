@@ -28,7 +28,6 @@
 //! [`SceneFile::load`]. The file format, units and conventions are in
 //! docs/scene-format.md.
 
-pub mod aov;
 pub mod camera;
 pub mod film;
 pub mod geometry;
@@ -53,6 +52,7 @@ pub type Rgb = glam::Vec3;
 
 pub use camera::{Camera, CameraRays};
 pub use film::Image;
+pub use render::aov;
 pub use render::{RenderObserver, render};
 pub use scene::{Scene, SceneBuilder};
 pub use scene_file::{SceneFile, fingerprint};

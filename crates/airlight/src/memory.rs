@@ -51,8 +51,26 @@ pub fn limit() -> Option<(u64, &'static str)> {
     };
     lower(meminfo_available(), "memory available on this machine");
     lower(cgroup_available(), "memory left to this control group");
-    lower(std::env::var(LIMIT_VAR).ok().and_then(|v| parse_size(&v)), "AIRLIGHT_MEMORY_LIMIT");
+    match limit_var() {
+        Ok(v) => lower(v, "AIRLIGHT_MEMORY_LIMIT"),
+        // A limit that cannot be read refuses everything rather than none:
+        // it was meant to hold the run back. Front ends refuse it first.
+        Err(_) => lower(Some(0), "AIRLIGHT_MEMORY_LIMIT, which is not a size"),
+    }
     best
+}
+
+/// The limit `AIRLIGHT_MEMORY_LIMIT` sets: None when it is not set; an
+/// error naming the value when it is not a size.
+pub fn limit_var() -> Result<Option<u64>, String> {
+    let refuse = |v: &dyn fmt::Debug| {
+        format!("{LIMIT_VAR}={v:?} is not a size: give bytes, or a number with K, M, G or T (e.g. 512M)")
+    };
+    match std::env::var(LIMIT_VAR) {
+        Err(std::env::VarError::NotPresent) => Ok(None),
+        Err(std::env::VarError::NotUnicode(v)) => Err(refuse(&v)),
+        Ok(v) => parse_size(&v).map(Some).ok_or_else(|| refuse(&v)),
+    }
 }
 
 /// Refuses `needed` bytes for `what` when they exceed [`limit`].
@@ -77,48 +95,6 @@ pub fn try_vec<T: Clone>(what: &str, n: usize, value: T) -> Result<Vec<T>, Memor
     })?;
     v.resize(n, value);
     Ok(v)
-}
-
-/// How a render keeps its pixels, which sets its memory ([`render_bytes`]).
-/// Files are encoded straight to disk, so none is counted.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum RenderFilm {
-    /// All samples in one go (`render::render`): each tile's sums live only
-    /// while it renders; the image and its encoded file (measured at 2048²:
-    /// 19.8 bytes a pixel in all).
-    Image,
-    /// A part of a render (`render::accumulate`): the accumulator's sums
-    /// (measured at 2048²: 121–122 bytes a pixel in all, the demo scene and
-    /// the Cornell box alike).
-    Sums,
-    /// Passes (`render::Progressive`): the accumulator, the image, a
-    /// variance image and an encoded file (measured at 2048²: 137 bytes a
-    /// pixel in all). A pass that may be `cancellable` (the study's) adds
-    /// into sums of its own first, so that a cancelled pass adds nothing.
-    Progressive { cancellable: bool },
-    /// Adaptive sampling (`render::adaptive`): the accumulator, which
-    /// holds the pilot and then every sample; while planning, each pixel's
-    /// noise twice (as measured, and its neighbours' largest; f64 each)
-    /// and its count of samples; then the image and its encoded file, as
-    /// [`RenderFilm::Image`] (measured at 2048²: 135 bytes a pixel in
-    /// all, the Cornell box).
-    Adaptive,
-}
-
-/// Bytes a render of `pixels` pixels holds at its peak: the sums and images
-/// each kind of render keeps ([`RenderFilm`]), with an image's worth to
-/// spare for the rest (tiles under way, encoders' buffers).
-pub fn render_bytes(pixels: u64, film: RenderFilm) -> u64 {
-    let sums = crate::film::ACCUMULATOR_BYTES_PER_PIXEL as u64;
-    let image = size_of::<crate::Rgb>() as u64;
-    let per_pixel = match film {
-        RenderFilm::Image => 2 * image,
-        RenderFilm::Sums => sums + 2 * image,
-        RenderFilm::Progressive { cancellable: false } => sums + 4 * image,
-        RenderFilm::Progressive { cancellable: true } => 2 * sums + 4 * image,
-        RenderFilm::Adaptive => sums + 2 * 8 + 4 + 2 * image,
-    };
-    pixels.saturating_mul(per_pixel)
 }
 
 /// `MemAvailable` from /proc/meminfo, in bytes.

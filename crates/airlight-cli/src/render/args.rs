@@ -1,7 +1,7 @@
 //! What `airlight render`'s command line says: its arguments, checked as
 //! clap parses them, and the scene file with their overrides applied.
 
-use crate::load;
+use crate::load::load;
 use crate::options::OptionFlags;
 use airlight::SceneFile;
 use std::path::PathBuf;
@@ -86,7 +86,7 @@ pub(super) fn configure(args: &RenderArgs) -> Result<SceneFile, String> {
         file.scene.set_attenuation_model(model).map_err(|e| format!("--attenuation: {e}"))?;
     }
     if let Some(MediumOption(medium)) = &args.medium {
-        file.scene.set_medium(medium.clone());
+        file.scene.set_medium(medium.clone()).map_err(|e| format!("--medium: {e}"))?;
     }
     Ok(file)
 }

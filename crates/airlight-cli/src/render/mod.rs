@@ -4,24 +4,22 @@
 //! to merge.
 
 mod args;
+mod progressive;
 
 pub use args::RenderArgs;
 
 use crate::aovs::Layers;
 use crate::preflight::Forecast;
 use crate::progress::Progress;
-use crate::progressive::{State, render_progressive, state_path};
 use crate::timing::Timing;
 use airlight::SceneFile;
-use airlight::aov::Aov;
 use airlight::film::Image;
-use airlight::film::partial::{Partial, PartialHeader, piece};
+use airlight::film::partial::{Partial, PartialHeader};
 use airlight::integrator::{Integrator, IntegratorKind};
-use airlight::memory::RenderFilm;
-use airlight::render::{RenderObserver, accumulate, frame_time, set_time};
+use airlight::render::{RenderJob, RenderMode, RenderObserver, RenderRequest, accumulate, frame_time, set_time};
 use airlight::scene::Scene;
 use args::{configure, output_paths};
-use std::ops::Range;
+use progressive::{State, render_progressive, state_path};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -33,20 +31,17 @@ pub(crate) struct FrameOutputs {
     pub layers: Layers,
 }
 
-/// What one `render` command computes: which frames, which samples of
-/// which rows, and whether as a partial render.
+/// What one `render` command computes: which frames, and the render job
+/// of each (its mode, which samples of which rows), checked by the
+/// library's rules.
 pub struct Plan {
     /// Frame numbers to render, with the count; None for a still image.
     frames: Option<(Vec<u32>, u32)>,
-    samples: Range<u64>,
-    rows: Range<u32>,
-    /// A shard or tile: written as a partial EXR.
-    partial: bool,
+    job: RenderJob,
 }
 
 impl Plan {
-    fn new(args: &RenderArgs, scene: &Scene) -> Result<Plan, String> {
-        let s = scene.settings();
+    fn new(args: &RenderArgs, scene: &Scene, integrator: IntegratorKind) -> Result<Plan, String> {
         let frames = match (args.frames, args.frame) {
             (Some(n), Some(k)) if k >= n => {
                 return Err(format!("--frame {k}: the animation has frames 0 to {} (--frames {n})", n - 1));
@@ -55,37 +50,30 @@ impl Plan {
             (Some(n), None) => Some(((0..n).collect(), n)),
             (None, _) => None,
         };
-        let part = |what: &str, part: Option<(u32, u32)>, total: u64, unit: &str| -> Result<Range<u64>, String> {
-            match part {
-                None => Ok(0..total),
-                Some((_, n)) if n as u64 > total => {
-                    Err(format!("--{what} K/{n}: the render has only {total} {unit}, so at most {total} {what}s"))
-                }
-                Some((k, n)) => Ok(piece(total, k as u64, n as u64)),
-            }
+        let request = RenderRequest {
+            shard: args.shard,
+            tile: args.tile,
+            passes: args.progressive || args.target_error.is_some(),
+            variance: args.variance.is_some(),
+            aovs: args.aov.clone().map(|list| list.0).unwrap_or_default(),
+            threads: args.threads,
         };
-        let samples = part("shard", args.shard, s.spp as u64, "samples per pixel")?;
-        let rows = part("tile", args.tile, s.height as u64, "rows")?;
-        let partial = args.shard.is_some() || args.tile.is_some();
-        if partial {
-            if args.progressive || args.target_error.is_some() || args.variance.is_some() {
-                return Err("--shard and --tile render a fixed part of the samples: they do not go with \
-                            --progressive, --target-error or --variance (merge the parts, then compare)"
-                    .into());
-            }
+        let job = request.check(scene.settings(), integrator)?;
+        if job.partial() {
             match args.output.as_slice() {
                 [one] if one.extension().is_some_and(|e| e.eq_ignore_ascii_case("exr")) => {}
                 _ => return Err("--shard and --tile write one partial render: give one `-o PART.exr`".into()),
             }
         }
-        Ok(Plan { frames, samples, rows: rows.start as u32..rows.end as u32, partial })
+        Ok(Plan { frames, job })
     }
 
     /// Pixel samples this plan renders.
     fn work(&self, scene: &Scene) -> u64 {
         let frames = self.frames.as_ref().map_or(1, |(list, _)| list.len() as u64);
-        let pixels = scene.settings().width as u64 * (self.rows.end - self.rows.start) as u64;
-        frames * pixels * (self.samples.end - self.samples.start)
+        let rows = &self.job.rows;
+        let pixels = scene.settings().width as u64 * (rows.end - rows.start) as u64;
+        frames * pixels * (self.job.samples.end - self.job.samples.start)
     }
 }
 
@@ -93,15 +81,12 @@ impl Plan {
 /// command line's overrides, what to render, and where it goes.
 pub fn prepare(args: &RenderArgs) -> Result<(SceneFile, Plan, Vec<PathBuf>), String> {
     let file = configure(args)?;
-    let plan = Plan::new(args, &file.scene)?;
+    let plan = Plan::new(args, &file.scene, file.integrator.kind)?;
     let outputs = output_paths(args)?;
     if let Some(v) = &args.variance
         && !v.extension().is_some_and(|e| e.eq_ignore_ascii_case("exr"))
     {
         return Err(format!("cannot write `{}`: the variance is written as .exr", v.display()));
-    }
-    if args.variance.is_some() && file.scene.settings().spp < 2 {
-        return Err("--variance: a variance needs at least 2 samples per pixel (--spp)".into());
     }
     if args.frames.is_some() && !file.scene.is_animated() {
         return Err("--frames: the scene has no light with keyframes to animate".into());
@@ -113,38 +98,13 @@ pub fn render(args: RenderArgs) -> Result<(), String> {
     let (SceneFile { mut scene, integrator: desc }, plan, outputs) = prepare(&args)?;
     // Of the scene as resolved, before any frame moves its lights.
     let fingerprint = airlight::fingerprint(&scene, &desc);
-    let aovs = args.aov.clone().map(|list| list.0).unwrap_or_default();
-    let progressive =
-        args.progressive || args.target_error.is_some() || args.variance.is_some() || aovs.contains(&Aov::Variance);
-    crate::aovs::check(&aovs, &outputs, plan.partial, desc.kind)?;
-    if scene.settings().adaptive && (plan.partial || progressive) {
-        return Err("adaptive sampling (--adaptive or `[render] adaptive`) renders in one go, its counts set by a \
-                    pilot pass: it does not go with --shard, --tile, --progressive, --target-error, --variance or \
-                    --aov variance"
-            .into());
-    }
-    if scene.settings().adaptive && aovs.contains(&Aov::Inscatter) {
-        // The layer is drawn with a uniform render's samples, so the image
-        // minus it would no longer be the surfaces' light sample for sample.
-        return Err("--aov inscatter is drawn with the samples of a uniform render: it does not go with adaptive \
-                    sampling (--adaptive or `[render] adaptive`)"
-            .into());
-    }
+    let job = &plan.job;
+    crate::aovs::check(&job.aovs, &outputs)?;
     let (files, variance) = (scene.files(), args.variance.as_deref());
     crate::outputs::check_render(args.scene.as_deref(), files, &outputs, variance, args.frames)?;
-    // As the frames below are rendered: a part first, then passes.
-    let film = match (plan.partial, progressive) {
-        (true, _) => RenderFilm::Sums,
-        (false, true) => RenderFilm::Progressive { cancellable: false },
-        (false, false) if scene.settings().adaptive => RenderFilm::Adaptive,
-        (false, false) => RenderFilm::Image,
-    };
-    crate::preflight::render_memory(&scene, film)?;
+    crate::preflight::render_memory(&scene, job.mode)?;
     crate::preflight::warn_if_dark(&scene, desc.kind != IntegratorKind::Direct);
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(args.threads.unwrap_or(0) as usize)
-        .build()
-        .map_err(|e| format!("cannot start worker threads: {e}"))?;
+    let pool = job.thread_pool()?;
     let start = Instant::now();
     // Built once: between frames the integrator only hears that the lights
     // moved (radiosity relights without recompiling).
@@ -179,10 +139,10 @@ pub fn render(args: RenderArgs) -> Result<(), String> {
         };
         let layers_start = Instant::now();
         let outputs = FrameOutputs {
-            layers: Layers::of_frame(&scene, integrator.as_ref(), &pool, &aovs, plan.samples.clone()),
+            layers: Layers::of_frame(&scene, integrator.as_ref(), &pool, &job.aovs, job.samples.clone()),
             ..outputs
         };
-        if !aovs.is_empty() {
+        if !job.aovs.is_empty() {
             timing.layers += layers_start.elapsed();
         }
         let frame_label = frame.map(|(k, n)| format!(" frame {k} of {n}")).unwrap_or_default();
@@ -194,17 +154,17 @@ pub fn render(args: RenderArgs) -> Result<(), String> {
             width: scene.settings().width,
             height: scene.settings().height,
             spp: scene.settings().spp,
-            samples: plan.samples.clone(),
-            rows: plan.rows.clone(),
+            samples: job.samples.clone(),
+            rows: job.rows.clone(),
             frame,
             exposure: scene.settings().exposure,
             tonemap: scene.settings().tonemap,
         };
         let run =
             Run { scene: &scene, integrator: integrator.as_ref(), pool: &pool, progress: &progress, label: &label };
-        let summary = if plan.partial {
+        let summary = if job.partial() {
             render_partial(&run, &outputs.images[0], header, &mut timing)?
-        } else if progressive {
+        } else if matches!(job.mode, RenderMode::Progressive { .. }) {
             let state = State { path: state_path(&outputs.images[0]), header, resume: args.resume };
             render_progressive(&run, &outputs, args.target_error, &state, &mut timing)?
         } else {
@@ -224,8 +184,8 @@ pub fn render(args: RenderArgs) -> Result<(), String> {
         if let Some((list, n)) = &plan.frames {
             what = format!("{} of {n} frames of {what}", list.len());
         }
-        if plan.partial {
-            what = format!("samples {:?} of rows {:?} of {what}", plan.samples, plan.rows);
+        if job.partial() {
+            what = format!("samples {:?} of rows {:?} of {what}", job.samples, job.rows);
         }
         let shown = if written.len() > 4 {
             format!("{}, …, {}", written[0], written[written.len() - 1])

@@ -2,8 +2,8 @@
 //! doubling size, each rewriting the outputs and the samples so far, which
 //! `--resume` continues from after an interruption.
 
+use super::{FrameOutputs, Run, format_error, write_images};
 use crate::progress::Progress;
-use crate::render::{FrameOutputs, Run, format_error, write_images};
 use crate::timing::Timing;
 use airlight::film::partial::{self, Partial, PartialHeader};
 use airlight::render::{Progressive, RenderObserver};

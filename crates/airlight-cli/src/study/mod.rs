@@ -18,7 +18,7 @@ mod run;
 mod steps;
 mod table;
 
-use crate::load;
+use crate::load::load;
 use crate::outputs::{self, Output};
 use crate::progress::Progress;
 use airlight::SceneFile;
@@ -141,9 +141,7 @@ fn check_memory(scene: &Scene, series: usize) -> Result<(), String> {
     let pixels = s.width as u64 * s.height as u64;
     let image = pixels.saturating_mul(size_of::<airlight::Rgb>() as u64);
     let kept = (series as u64 + 4).saturating_mul(image);
-    let needed =
-        airlight::memory::render_bytes(pixels, airlight::memory::RenderFilm::Progressive { cancellable: true })
-            .saturating_add(kept);
+    let needed = airlight::render::RenderMode::Progressive { cancellable: true }.bytes(pixels).saturating_add(kept);
     airlight::memory::check(format!("a {}×{} study", s.width, s.height), needed)
         .map_err(|e| format!("{e}: make the image smaller (--width, --height)"))
 }
@@ -196,10 +194,7 @@ pub fn study(args: StudyArgs) -> Result<(), String> {
     check_memory(&scene, plan::ladder(&scene, &desc, &kinds).0.len())?;
     crate::preflight::warn_if_dark(&scene, true);
     prepare_dir(&dir, &args, &scene)?;
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(args.threads.unwrap_or(0) as usize)
-        .build()
-        .map_err(|e| format!("cannot start worker threads: {e}"))?;
+    let pool = airlight::render::thread_pool(args.threads)?;
     let stop = Arc::new(AtomicBool::new(false));
     for signal in [signal_hook::consts::SIGINT, signal_hook::consts::SIGTERM] {
         // A second Ctrl-C ends the study at once; the first stops it tidily.

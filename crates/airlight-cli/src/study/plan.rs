@@ -4,7 +4,7 @@
 //! at 1, 2, 4, … samples per pixel.
 
 use super::data::{NotRun, Transport};
-use airlight::integrator::{IntegratorDesc, IntegratorKind, MAX_LIGHT_STEPS, MAX_STEPS};
+use airlight::integrator::{Estimate, IntegratorDesc, IntegratorKind, MAX_LIGHT_STEPS, MAX_STEPS};
 use airlight::light::{AttenuationModel, Light};
 use airlight::scene::Scene;
 
@@ -32,14 +32,14 @@ pub const ATTENUATION_MODELS: [(AttenuationModel, &str); 6] = [
 ];
 
 /// Which transport an integrator computes: single-scattering methods are
-/// measured against path at max_depth 1, the others against the scene's.
-pub fn transport(kind: IntegratorKind, desc: &IntegratorDesc) -> Transport {
-    match kind {
-        IntegratorKind::Direct | IntegratorKind::Raymarch | IntegratorKind::Analytic | IntegratorKind::Stochastic => {
-            Transport::Single
-        }
-        IntegratorKind::Path if desc.path.max_depth == 1 => Transport::Single,
-        IntegratorKind::Path | IntegratorKind::Radiosity => Transport::Full,
+/// measured against path at max_depth 1, the others against the scene's;
+/// None for a debug view, which estimates no light and is not studied.
+pub fn transport(kind: IntegratorKind, desc: &IntegratorDesc) -> Option<Transport> {
+    match kind.estimate() {
+        Estimate::Direct | Estimate::SingleScattering => Some(Transport::Single),
+        Estimate::Full if kind == IntegratorKind::Path && desc.path.max_depth == 1 => Some(Transport::Single),
+        Estimate::Full => Some(Transport::Full),
+        Estimate::DebugView => None,
     }
 }
 
@@ -58,8 +58,9 @@ pub fn ladder(scene: &Scene, base: &IntegratorDesc, kinds: &[IntegratorKind]) ->
     let mut refused = Vec::new();
     let mut push = |kind: IntegratorKind, id: String, setting: String, desc: IntegratorDesc| {
         let label = if setting.is_empty() { kind.name().to_string() } else { format!("{kind}, {setting}") };
-        let transport = transport(kind, &desc);
-        plans.push(SeriesPlan { id, label, kind, setting, desc, attenuation: None, transport });
+        if let Some(transport) = transport(kind, &desc) {
+            plans.push(SeriesPlan { id, label, kind, setting, desc, attenuation: None, transport });
+        }
     };
     let medium = scene.medium().is_some();
     // Every integrator there is, the path tracer first.
@@ -67,6 +68,11 @@ pub fn ladder(scene: &Scene, base: &IntegratorDesc, kinds: &[IntegratorKind]) ->
     order.sort_by_key(|k| *k != IntegratorKind::Path);
     for kind in order {
         if !kinds.contains(&kind) {
+            continue;
+        }
+        if kind.estimate() == Estimate::DebugView {
+            let reason = "a view of the scene's geometry, not an estimate of its light: nothing to measure";
+            refused.push(NotRun { label: kind.name().into(), reason: reason.into() });
             continue;
         }
         let desc = base.with_kind(kind);

@@ -75,7 +75,7 @@ pub struct ViewArgs {
 
 pub fn run(args: ViewArgs) -> Result<(), String> {
     let (file, name) = match &args.scene {
-        Some(p) => (crate::load(Some(p))?, p.display().to_string()),
+        Some(p) => (crate::load::load(Some(p))?, p.display().to_string()),
         None => (
             airlight::SceneFile::from_toml_str(DEFAULT_SCENE, None).map_err(|e| format!("built-in scene: {e}"))?,
             "the built-in Cornell box".to_string(),
@@ -85,12 +85,20 @@ pub fn run(args: ViewArgs) -> Result<(), String> {
     let pixels = args.width as u64 * args.height as u64;
     airlight::memory::check(
         format!("a {}×{} view", args.width, args.height),
-        airlight::memory::render_bytes(pixels, airlight::memory::RenderFilm::Progressive { cancellable: false }),
+        airlight::render::RenderMode::Progressive { cancellable: false }.bytes(pixels),
     )
     .map_err(|e| format!("{e}: make it smaller (--width, --height)"))?;
     crate::preflight::warn_if_dark(scene, true);
     if let Some(dir) = args.out.as_deref().filter(|_| args.headless) {
-        crate::outputs::check_folder("--out", dir)?;
+        let names = (0..args.frames).flat_map(|k| ["exr", "png"].map(|ext| format!("frame_{k:04}.{ext}")));
+        let inputs: Vec<&std::path::Path> = args
+            .scene
+            .iter()
+            .map(std::path::PathBuf::as_path)
+            .chain(args.path.as_deref())
+            .chain(scene.files().iter().map(std::path::PathBuf::as_path))
+            .collect();
+        crate::outputs::check_in_folder("--out", dir, names, &inputs)?;
     }
     if !(args.period.is_finite() && args.period > 0.0) {
         return Err(format!("--period must be a positive number of seconds, got {}", args.period));
@@ -100,10 +108,7 @@ pub fn run(args: ViewArgs) -> Result<(), String> {
         None => Script::scene_keyframes(),
     };
     let start = Start { camera: *scene.camera(), lights: scene.lights().to_vec(), paths: scene.light_paths().to_vec() };
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(args.threads.unwrap_or(0) as usize)
-        .build()
-        .map_err(|e| format!("cannot start worker threads: {e}"))?;
+    let pool = airlight::render::thread_pool(args.threads)?;
     pool.install(|| {
         let mode = args.integrator.or(script.integrator).unwrap_or(Mode::Preview);
         let t = std::time::Instant::now();

@@ -14,9 +14,13 @@ pub use compare::{ImageError, compare, error_map};
 pub use partial::{Partial, PartialHeader};
 
 use crate::Rgb;
-use crate::scene::{MAX_IMAGE_SIDE, MAX_PIXELS};
 use std::io;
 use std::path::Path;
+
+/// Largest image side.
+pub const MAX_IMAGE_SIDE: u32 = 1 << 16;
+/// Most pixels in an image (16384²).
+pub const MAX_PIXELS: u64 = 1 << 28;
 
 /// Largest EXR file read (a 16384² RGB float image uncompressed is 3 GiB).
 pub const MAX_EXR_BYTES: u64 = 4 << 30;

@@ -14,15 +14,15 @@ mod radiosity;
 mod raymarch;
 mod stochastic;
 
+pub use crate::radiosity::{DEFAULT_LINK_THRESHOLD, RadiosityOptions};
 pub use analytic::{Analytic, AnalyticOptions};
 pub(crate) use batch::DeferredShadows;
 pub use batch::first_surface_batch;
 pub use direct::Direct;
 pub use equiangular::Equiangular;
 pub use options::{
-    DEFAULT_LINK_THRESHOLD, INTEGRATOR_OPTIONS, IntegratorDesc, IntegratorError, IntegratorOption, MAX_BOUNCES,
-    MAX_DEPTH, MAX_LIGHT_STEPS, MAX_STEPS, OptionError, PathOptions, RadiosityOptions, RaymarchOptions,
-    StochasticOptions,
+    INTEGRATOR_OPTIONS, IntegratorDesc, IntegratorError, IntegratorOption, MAX_BOUNCES, MAX_DEPTH, MAX_LIGHT_STEPS,
+    MAX_STEPS, OptionError, PathOptions, RaymarchOptions, StochasticOptions,
 };
 pub use path::PathTracer;
 pub use radiosity::{RadiosityIntegrator, indirect_radiance};
@@ -128,18 +128,38 @@ impl IntegratorKind {
         IntegratorKind::Radiosity,
     ];
 
+    /// The integrators' names, in [`IntegratorKind::ALL`]'s order: the
+    /// values `[render] integrator` takes.
+    pub const NAMES: [&'static str; Self::ALL.len()] = {
+        let mut names = [""; Self::ALL.len()];
+        let mut i = 0;
+        while i < names.len() {
+            names[i] = Self::ALL[i].name();
+            i += 1;
+        }
+        names
+    };
+
+    /// What the integrator's image is an estimate of.
+    pub fn estimate(self) -> Estimate {
+        match self {
+            IntegratorKind::Direct => Estimate::Direct,
+            IntegratorKind::Raymarch | IntegratorKind::Analytic | IntegratorKind::Stochastic => {
+                Estimate::SingleScattering
+            }
+            IntegratorKind::Path | IntegratorKind::Radiosity => Estimate::Full,
+        }
+    }
+
     /// Whether the integrator's [`Integrator::radiance_parts`] gives the
     /// surface's light and the medium's apart (the single-scattering
     /// integrators), so that the medium's light can be written alone; known
     /// before the integrator is built (radiosity's build is long).
     pub fn separates_in_scattering(self) -> bool {
-        match self {
-            IntegratorKind::Raymarch | IntegratorKind::Analytic | IntegratorKind::Stochastic => true,
-            IntegratorKind::Direct | IntegratorKind::Path | IntegratorKind::Radiosity => false,
-        }
+        self.estimate() == Estimate::SingleScattering
     }
 
-    pub fn name(self) -> &'static str {
+    pub const fn name(self) -> &'static str {
         match self {
             IntegratorKind::Direct => "direct",
             IntegratorKind::Raymarch => "raymarch",
@@ -149,6 +169,24 @@ impl IntegratorKind {
             IntegratorKind::Radiosity => "radiosity",
         }
     }
+}
+
+/// What an integrator's image estimates, so that tools can treat
+/// integrators by what they compute rather than by a list of names.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Estimate {
+    /// Direct light on surfaces; any medium is ignored.
+    Direct,
+    /// Direct light on surfaces seen through the medium, plus the light
+    /// the medium scatters once toward the camera; [`Integrator::radiance_parts`]
+    /// gives the two apart.
+    SingleScattering,
+    /// Light that has bounced any number of times (up to the integrator's
+    /// own limit).
+    Full,
+    /// Not radiance: a view of the scene's geometry, for looking at a scene
+    /// rather than lighting it.
+    DebugView,
 }
 
 impl std::str::FromStr for IntegratorKind {

@@ -17,7 +17,7 @@ use super::{
     Analytic, Direct, Integrator, IntegratorKind, PathTracer, RadiosityIntegrator, Raymarch, Sampling, Stochastic,
 };
 use crate::options::{Checked, NumberRange, OptionSpec, OptionValue, ValueKind, set_named};
-use crate::radiosity::RadiosityError;
+use crate::radiosity::{RadiosityError, RadiosityOptions};
 use crate::scene::Scene;
 
 pub use crate::options::OptionError;
@@ -95,37 +95,6 @@ impl Default for PathOptions {
     }
 }
 
-/// Default of [`RadiosityOptions::link_threshold`].
-pub const DEFAULT_LINK_THRESHOLD: f32 = 0.02;
-
-/// `radiosity`: patches, links and bounces. In a medium its camera rays
-/// are marched with the raymarch options.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct RadiosityOptions {
-    /// Side length (world units) surfaces are cut into patches of; None
-    /// picks 1/32 of the largest extent of the bounded geometry.
-    pub patch_size: Option<f32>,
-    /// Bounces of indirect light (1 = one bounce, as in Madams technique).
-    pub bounces: u32,
-    /// A patch links to a whole cluster instead of its children when the
-    /// cluster's estimated form factor A/(π d²) is below this; 0 links
-    /// every patch to every patch it sees (the O(N²) solution).
-    pub link_threshold: f32,
-}
-
-impl Default for RadiosityOptions {
-    fn default() -> Self {
-        RadiosityOptions { patch_size: None, bounces: 1, link_threshold: DEFAULT_LINK_THRESHOLD }
-    }
-}
-
-impl RadiosityOptions {
-    /// Checks the radiosity options by their declarations.
-    pub fn validate(&self) -> Result<(), OptionError> {
-        IntegratorDesc { radiosity: *self, ..IntegratorDesc::default() }.validate()
-    }
-}
-
 impl Default for AnalyticOptions {
     fn default() -> Self {
         AnalyticOptions { shadows: false, light_steps: 16, quadrature: LightQuadrature::Gauss }
@@ -170,7 +139,7 @@ pub const INTEGRATOR_OPTIONS: &[IntegratorOption] = &[
     IntegratorOption {
         spec: OptionSpec {
             key: "integrator",
-            kind: ValueKind::Name(&["direct", "raymarch", "analytic", "stochastic", "path", "radiosity"]),
+            kind: ValueKind::Name(&IntegratorKind::NAMES),
             unit: "",
             doc: "The integrator that renders the image.",
             default_doc: Some("raymarch if the scene has a medium, else direct"),

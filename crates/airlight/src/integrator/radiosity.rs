@@ -2,7 +2,7 @@
 //! the patches (direct and indirect light "at different frequencies").
 
 use super::raymarch::march;
-use super::{Integrator, IntegratorError, RadiosityOptions, RaymarchOptions, single_scattering};
+use super::{Integrator, IntegratorDesc, IntegratorError, RadiosityOptions, RaymarchOptions, single_scattering};
 use crate::Rgb;
 use crate::geometry::{Ray, SurfaceHit};
 use crate::radiosity::{CompileParams, FrameTimes, Radiosity};
@@ -36,7 +36,7 @@ pub struct RadiosityIntegrator {
 impl RadiosityIntegrator {
     /// Compiles and lights `scene`.
     pub fn new(scene: &Scene, options: RadiosityOptions, march: RaymarchOptions) -> Result<Self, IntegratorError> {
-        options.validate()?;
+        IntegratorDesc { radiosity: options, raymarch: march, ..IntegratorDesc::default() }.validate()?;
         let mut solution = Radiosity::compile_with(scene, CompileParams::for_scene(scene, &options))?;
         let last_update = solution.update(scene, options.bounces);
         Ok(RadiosityIntegrator { solution, options, march, last_update })

@@ -36,7 +36,6 @@ pub mod lookup;
 pub mod patches;
 
 use crate::Rgb;
-use crate::integrator::RadiosityOptions;
 use crate::material::Material;
 use crate::scene::Scene;
 use glam::Vec3;
@@ -140,6 +139,31 @@ impl CompileParams {
             receiver_share: if large { LARGE_RECEIVER_SHARE } else { 0.0 },
             seed: scene.settings().seed,
         }
+    }
+}
+
+/// Default of [`RadiosityOptions::link_threshold`].
+pub const DEFAULT_LINK_THRESHOLD: f32 = 0.02;
+
+/// The radiosity integrator's options (`[render]` patch_size, bounces,
+/// link_threshold): patches, links and bounces. In a medium its camera
+/// rays are marched with the raymarch options.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RadiosityOptions {
+    /// Side length (world units) surfaces are cut into patches of; None
+    /// picks 1/32 of the largest extent of the bounded geometry.
+    pub patch_size: Option<f32>,
+    /// Bounces of indirect light (1 = one bounce, as in Madams technique).
+    pub bounces: u32,
+    /// A patch links to a whole cluster instead of its children when the
+    /// cluster's estimated form factor A/(π d²) is below this; 0 links
+    /// every patch to every patch it sees (the O(N²) solution).
+    pub link_threshold: f32,
+}
+
+impl Default for RadiosityOptions {
+    fn default() -> Self {
+        RadiosityOptions { patch_size: None, bounces: 1, link_threshold: DEFAULT_LINK_THRESHOLD }
     }
 }
 

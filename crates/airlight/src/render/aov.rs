@@ -8,10 +8,10 @@
 //! for the single-scattering integrators, the medium's light alone,
 //! `inscatter.R/G/B`.
 
+use super::PixelSample;
 use crate::Rgb;
 use crate::film::Image;
 use crate::integrator::Integrator;
-use crate::render::PixelSample;
 use crate::scene::Scene;
 use glam::Vec3;
 use rayon::prelude::*;

@@ -14,8 +14,11 @@ use std::ops::Range;
 use std::sync::atomic::{AtomicBool, Ordering};
 
 pub mod adaptive;
+pub mod aov;
+mod job;
 mod samples;
 
+pub use job::{MAX_THREADS, RenderJob, RenderMode, RenderRequest, thread_pool};
 use samples::tile_sums;
 pub use samples::{BLOCK, BLOCK_ORDER, PixelSample, pixel_sum};
 

@@ -32,10 +32,9 @@ pub struct RenderSettings {
     pub adaptive: bool,
 }
 
-/// Largest image side.
-pub const MAX_IMAGE_SIDE: u32 = 1 << 16;
-/// Most pixels in an image (16384²).
-pub const MAX_PIXELS: u64 = 1 << 28;
+/// The image's limits are the film's.
+pub use crate::film::{MAX_IMAGE_SIDE, MAX_PIXELS};
+
 /// Most samples per pixel.
 pub const MAX_SPP: u32 = 1 << 24;
 
