@@ -33,7 +33,7 @@ _Path = Union[str, "os.PathLike[str]"]
 _Image = npt.NDArray[np.float32]
 _ArrayLike = npt.ArrayLike
 # integrators: begin
-_Integrator = Literal["direct", "raymarch", "analytic", "stochastic", "path", "radiosity"]
+_Integrator = Literal["direct", "raymarch", "analytic", "stochastic", "path", "radiosity", "ambient_occlusion"]
 # integrators: end
 
 class _Bar(Protocol):
@@ -180,6 +180,7 @@ class Scene:
         bounces: int | None = None,
         patch_size: float | None = None,
         link_threshold: float | None = None,
+        ao_distance: float | None = None,
         # render-options: end
     ) -> _Image: ...
     @overload
@@ -215,6 +216,7 @@ class Scene:
         bounces: int | None = None,
         patch_size: float | None = None,
         link_threshold: float | None = None,
+        ao_distance: float | None = None,
         # render-options: end
     ) -> _AOVs:
         """Renders the scene: linear RGB, float32, shape (height, width, 3).

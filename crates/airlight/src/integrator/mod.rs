@@ -3,6 +3,7 @@
 //! function ([`IntegratorDesc::build`]); a scene file's `[render]
 //! integrator` picks one.
 
+mod ambient_occlusion;
 pub mod analytic;
 mod batch;
 mod direct;
@@ -15,6 +16,7 @@ mod raymarch;
 mod stochastic;
 
 pub use crate::radiosity::{DEFAULT_LINK_THRESHOLD, RadiosityOptions};
+pub use ambient_occlusion::{AmbientOcclusion, AmbientOcclusionOptions};
 pub use analytic::{Analytic, AnalyticOptions};
 pub(crate) use batch::DeferredShadows;
 pub use batch::first_surface_batch;
@@ -116,16 +118,19 @@ pub enum IntegratorKind {
     Path,
     /// Radiosity with a patch hierarchy.
     Radiosity,
+    /// A view of the geometry: how open each first surface's hemisphere is.
+    AmbientOcclusion,
 }
 
 impl IntegratorKind {
-    pub const ALL: [IntegratorKind; 6] = [
+    pub const ALL: [IntegratorKind; 7] = [
         IntegratorKind::Direct,
         IntegratorKind::Raymarch,
         IntegratorKind::Analytic,
         IntegratorKind::Stochastic,
         IntegratorKind::Path,
         IntegratorKind::Radiosity,
+        IntegratorKind::AmbientOcclusion,
     ];
 
     /// The integrators' names, in [`IntegratorKind::ALL`]'s order: the
@@ -148,6 +153,7 @@ impl IntegratorKind {
                 Estimate::SingleScattering
             }
             IntegratorKind::Path | IntegratorKind::Radiosity => Estimate::Full,
+            IntegratorKind::AmbientOcclusion => Estimate::DebugView,
         }
     }
 
@@ -167,6 +173,7 @@ impl IntegratorKind {
             IntegratorKind::Stochastic => "stochastic",
             IntegratorKind::Path => "path",
             IntegratorKind::Radiosity => "radiosity",
+            IntegratorKind::AmbientOcclusion => "ambient_occlusion",
         }
     }
 }

@@ -14,7 +14,8 @@
 
 use super::analytic::{AnalyticOptions, LightQuadrature};
 use super::{
-    Analytic, Direct, Integrator, IntegratorKind, PathTracer, RadiosityIntegrator, Raymarch, Sampling, Stochastic,
+    AmbientOcclusion, AmbientOcclusionOptions, Analytic, Direct, Integrator, IntegratorKind, PathTracer,
+    RadiosityIntegrator, Raymarch, Sampling, Stochastic,
 };
 use crate::options::{Checked, NumberRange, OptionSpec, OptionValue, ValueKind, set_named};
 use crate::radiosity::{RadiosityError, RadiosityOptions};
@@ -111,6 +112,7 @@ pub struct IntegratorDesc {
     pub stochastic: StochasticOptions,
     pub path: PathOptions,
     pub radiosity: RadiosityOptions,
+    pub ambient_occlusion: AmbientOcclusionOptions,
 }
 
 impl Default for IntegratorDesc {
@@ -300,6 +302,18 @@ pub const INTEGRATOR_OPTIONS: &[IntegratorOption] = &[
         },
         takes: &[RadiosityKind],
     },
+    IntegratorOption {
+        spec: OptionSpec {
+            key: "ao_distance",
+            kind: ValueKind::Number(NumberRange::Positive),
+            unit: "world units",
+            doc: "How far a direction from a surface must be open to count as open.",
+            default_doc: None,
+            get: |d| OptionValue::real(d.ambient_occlusion.distance),
+            set: |d, v| d.ambient_occlusion.distance = v.number() as f32,
+        },
+        takes: &[IntegratorKind::AmbientOcclusion],
+    },
 ];
 
 impl IntegratorDesc {
@@ -312,6 +326,7 @@ impl IntegratorDesc {
             stochastic: StochasticOptions::default(),
             path: PathOptions::default(),
             radiosity: RadiosityOptions::default(),
+            ambient_occlusion: AmbientOcclusionOptions::default(),
         }
     }
 
@@ -353,6 +368,7 @@ impl IntegratorDesc {
             IntegratorKind::Stochastic => Box::new(Stochastic::new(self.stochastic)),
             IntegratorKind::Path => Box::new(PathTracer::new(self.path)),
             IntegratorKind::Radiosity => Box::new(RadiosityIntegrator::new(scene, self.radiosity, self.raymarch)?),
+            IntegratorKind::AmbientOcclusion => Box::new(AmbientOcclusion::new(self.ambient_occlusion)),
         })
     }
 }
