@@ -29,6 +29,14 @@ fn identity(path: &Path) -> Result<PathBuf, String> {
     Ok(resolved.join(name))
 }
 
+/// Whether `a` and `b` name the same file, their folders resolved.
+pub fn same_file(a: &Path, b: &Path) -> bool {
+    match (identity(a), identity(b)) {
+        (Ok(x), Ok(y)) => x == y,
+        _ => a == b,
+    }
+}
+
 /// Whether this process may create files in `folder`.
 fn writable(folder: &Path) -> bool {
     use std::os::unix::ffi::OsStrExt;

@@ -132,7 +132,7 @@ fn aovs_are_layers_of_the_exr_with_standard_names() {
     let unknown = airlight(dir.path(), &["render", "s.toml", "--aov", "albedo,colour", "-o", "a.exr", "-q"]);
     assert!(String::from_utf8_lossy(&unknown.stderr).contains("unknown AOV `colour`"));
     let shard = airlight(dir.path(), &["render", "s.toml", "--aov", "depth", "--shard", "0/2", "-o", "p.exr", "-q"]);
-    assert!(String::from_utf8_lossy(&shard.stderr).contains("a shard or tile is a partial EXR"));
+    assert!(String::from_utf8_lossy(&shard.stderr).contains("a shard or tile holds part of the samples"));
     assert!(!dir.path().join("a.exr").exists() && !dir.path().join("p.exr").exists());
 }
 

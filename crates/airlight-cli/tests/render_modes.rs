@@ -134,6 +134,27 @@ fn an_interrupted_progressive_render_resumes_to_the_uninterrupted_image() {
     let refused = airlight(d, &[&args[..], &["--progressive", "--resume", "-o", "y.exr"]].concat());
     assert!(!refused.status.success());
     assert!(String::from_utf8_lossy(&refused.stderr).contains("not an Airlight partial render"));
+    // Resuming a finished render would replace it pass by pass: refused.
+    let finished = std::fs::read(d.join("whole.exr")).unwrap();
+    let again = airlight(d, &[&args[..], &["--progressive", "--resume", "-o", "whole.exr", "--quiet"]].concat());
+    let stderr = String::from_utf8_lossy(&again.stderr);
+    assert!(!again.status.success() && stderr.contains("the render finished"), "{stderr}");
+    assert_eq!(std::fs::read(d.join("whole.exr")).unwrap(), finished);
+    // The checkpoint may be no output and no input.
+    let small = ["--quiet"];
+    for (extra, phrase) in [
+        (&["-o", "p.exr", "-o", "p.partial.exr"][..], "is where the passes keep their samples"),
+        (&["-o", "q.exr", "--variance", "q.partial.exr"][..], "is where the passes keep their samples"),
+    ] {
+        let run = airlight(d, &[&args[..], &["--progressive"], extra, &small].concat());
+        let stderr = String::from_utf8_lossy(&run.stderr);
+        assert!(!run.status.success() && stderr.contains(phrase), "{extra:?}: {stderr}");
+    }
+    std::fs::copy(scene, d.join("a.partial.exr")).unwrap();
+    let run = airlight(d, &["render", "a.partial.exr", "--progressive", "-o", "a.exr", "--spp", "2", "--quiet"]);
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert!(!run.status.success() && stderr.contains("would replace an input"), "{stderr}");
+    assert_eq!(std::fs::read(d.join("a.partial.exr")).unwrap(), std::fs::read(scene).unwrap());
 }
 
 #[test]

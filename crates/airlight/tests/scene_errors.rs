@@ -53,7 +53,7 @@ fn cases() -> Vec<(String, usize, &'static str)> {
         (
             with("[render]\nintegrator = \"magic\""),
             2,
-            "render.integrator must be direct, raymarch, analytic, stochastic, path or radiosity, got the text \"magic\"",
+            "render.integrator must be direct, raymarch, analytic, stochastic, path, radiosity or ambient_occlusion, got the text \"magic\"",
         ),
         // 9. Position with two numbers.
         (with("[camera]\nposition = [0, 1]"), 2, "invalid length 2, expected an array of three numbers"),

@@ -102,6 +102,9 @@ pub fn render(args: RenderArgs) -> Result<(), String> {
     crate::aovs::check(&job.aovs, &outputs)?;
     let (files, variance) = (scene.files(), args.variance.as_deref());
     crate::outputs::check_render(args.scene.as_deref(), files, &outputs, variance, args.frames)?;
+    if matches!(job.mode, RenderMode::Progressive { .. }) {
+        check_checkpoints(&args, files, &outputs)?;
+    }
     crate::preflight::render_memory(&scene, job.mode)?;
     crate::preflight::warn_if_dark(&scene, desc.kind != IntegratorKind::Direct);
     let pool = job.thread_pool()?;
@@ -195,6 +198,52 @@ pub fn render(args: RenderArgs) -> Result<(), String> {
         eprintln!("rendered {what} in {} → {shown}", timing.summary(elapsed));
     }
     Ok(())
+}
+
+/// Passes keep their samples beside the first output (`NAME.partial.exr`,
+/// numbered with the frames): that file is written and, once the render is
+/// done, removed, so it may be no input and no other output.
+fn check_checkpoints(args: &RenderArgs, files: &[PathBuf], outputs: &[PathBuf]) -> Result<(), String> {
+    let first = &outputs[0];
+    let inputs: Vec<&Path> = args.scene.as_deref().into_iter().chain(files.iter().map(PathBuf::as_path)).collect();
+    match args.frames {
+        None => {
+            let checkpoint = state_path(first);
+            let mut written: Vec<crate::outputs::Output> =
+                outputs.iter().map(|path| crate::outputs::Output { option: "-o", path }).collect();
+            written.extend(args.variance.as_deref().map(|path| crate::outputs::Output { option: "--variance", path }));
+            for out in &written {
+                if crate::outputs::same_file(out.path, &checkpoint) {
+                    return Err(format!(
+                        "{} `{}` is where the passes keep their samples (`{}`), which is removed when the render \
+                         is done: choose another name",
+                        out.option,
+                        out.path.display(),
+                        checkpoint.display()
+                    ));
+                }
+            }
+            crate::outputs::check(&[crate::outputs::Output { option: "the checkpoint", path: &checkpoint }], &inputs)
+        }
+        // A frame's checkpoint is NAME_0007.partial.exr: an input of that
+        // form, for a frame rendered, would be replaced.
+        Some(n) => {
+            let stem = first.file_stem().unwrap_or_default().to_string_lossy();
+            for input in &inputs {
+                let name = input.file_name().unwrap_or_default().to_string_lossy();
+                let frame = name.strip_prefix(&format!("{stem}_")).and_then(|r| r.strip_suffix(".partial.exr"));
+                if let Some(k) = frame.and_then(|k| k.parse::<u32>().ok()).filter(|&k| k < n)
+                    && crate::outputs::same_file(input, &state_path(&numbered(first, k)))
+                {
+                    return Err(format!(
+                        "the checkpoint of frame {k} would replace the input `{}`: choose another -o name",
+                        input.display()
+                    ));
+                }
+            }
+            Ok(())
+        }
+    }
 }
 
 /// `path` with `_NNNN` (the frame number) before its extension.

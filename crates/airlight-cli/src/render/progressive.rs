@@ -27,7 +27,19 @@ pub(crate) fn state_path(output: &Path) -> PathBuf {
 
 /// The progressive render that `state` holds the first samples of, when
 /// resuming and it is there; it must be of this very render.
-fn resumed(scene: &Scene, state: &State, progress: &Progress) -> Result<Progressive, String> {
+fn resumed(scene: &Scene, state: &State, outputs: &FrameOutputs, progress: &Progress) -> Result<Progressive, String> {
+    if state.resume && !state.path.exists() {
+        // Without its samples, a finished image would be replaced pass by
+        // pass by one of fewer samples.
+        if let Some(done) = outputs.images.iter().chain(&outputs.variance).find(|p| p.exists()) {
+            return Err(format!(
+                "--resume: there are no samples to continue (`{}`), and `{}` exists: the render finished, or another \
+                 wrote it; remove it to render again",
+                state.path.display(),
+                done.display()
+            ));
+        }
+    }
     if !state.resume || !state.path.exists() {
         if state.resume {
             progress.println(&format!("--resume: no `{}`, starting from the first sample", state.path.display()));
@@ -66,7 +78,7 @@ pub(crate) fn render_progressive(
 ) -> Result<String, String> {
     let Run { scene, integrator, pool, progress, label } = *run;
     let s = scene.settings();
-    let mut progressive = resumed(scene, state, progress)?;
+    let mut progressive = resumed(scene, state, outputs, progress)?;
     let mut error = progressive.estimated_relative_error();
     if progressive.samples() > 0 && (progressive.finished() || target_error.is_some_and(|target| error < target)) {
         // Stopped after its last pass, before it tidied up: the images again.

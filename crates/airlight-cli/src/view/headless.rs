@@ -1,10 +1,10 @@
 //! `airlight view --headless`: the window's frame loop without a window,
-//! driven by a script ([`super::path`]) instead of keys; it prints each
+//! driven by a script ([`super::script`]) instead of keys; it prints each
 //! frame's times and their median and p95, and writes the frames if asked.
 //! Tests and benchmarks use it.
 
 use super::engine::{Engine, FrameStats};
-use super::path::Script;
+use super::script::Script;
 use airlight::Camera;
 use airlight::light::{Keyframes, Light};
 use std::path::Path;

@@ -14,13 +14,13 @@ pub mod engine;
 pub mod headless;
 #[cfg(any(feature = "viewer", test))]
 pub mod input;
-pub mod path;
+pub mod script;
 #[cfg(feature = "viewer")]
 mod window;
 
 use engine::{Engine, Mode};
 use headless::Start;
-use path::Script;
+use script::Script;
 use std::path::PathBuf;
 
 /// The scene viewed when none is named: the Cornell box, whose ceiling light
@@ -104,7 +104,7 @@ pub fn run(args: ViewArgs) -> Result<(), String> {
         return Err(format!("--period must be a positive number of seconds, got {}", args.period));
     }
     let script = match &args.path {
-        Some(p) => path::load(p, scene).map_err(|e| e.to_string())?,
+        Some(p) => script::load(p, scene).map_err(|e| e.to_string())?,
         None => Script::scene_keyframes(),
     };
     let start = Start { camera: *scene.camera(), lights: scene.lights().to_vec(), paths: scene.light_paths().to_vec() };

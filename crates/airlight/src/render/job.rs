@@ -126,14 +126,14 @@ impl RenderRequest {
         let partial = self.shard.is_some() || self.tile.is_some();
         let variance = self.variance || self.aovs.contains(&Aov::Variance);
         let passes = self.passes || variance;
-        if partial && passes {
-            return Err("a shard or tile renders a fixed part of the samples: it does not go with passes, an error \
-                        target or a variance (merge the parts, then compare)"
-                .into());
-        }
         if partial && !self.aovs.is_empty() {
             return Err("AOVs: a shard or tile holds part of the samples as sums; render the AOVs with the merged \
                         image's settings, without a shard or tile"
+                .into());
+        }
+        if partial && passes {
+            return Err("a shard or tile renders a fixed part of the samples: it does not go with passes, an error \
+                        target or a variance (merge the parts, then compare)"
                 .into());
         }
         if variance && settings.spp < 2 {

@@ -63,6 +63,14 @@ fn read_fields(
     Ok(fields)
 }
 
+/// The text of field `key` of a partial file's header, if it has one.
+pub(super) fn field(
+    attributes: &std::collections::HashMap<exr::meta::attribute::Text, exr::meta::attribute::AttributeValue>,
+    key: &str,
+) -> Result<Option<String>, String> {
+    Ok(read_fields(attributes)?.remove(key))
+}
+
 /// The header that a partial file's attributes describe, checked: every
 /// field present and in range, the format one this build reads.
 pub(super) fn parse_header(

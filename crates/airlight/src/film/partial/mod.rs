@@ -90,9 +90,30 @@ impl Partial {
     pub fn read(path: &Path) -> Result<Partial, String> {
         use exr::prelude::*;
         let meta = exr::meta::MetaData::read_from_file(path, false).map_err(|e| format!("not a readable EXR: {e}"))?;
-        let header = meta.headers.first().ok_or("an EXR without layers")?;
-        let header = parse_header(&header.own_attributes.other)?;
+        let exr_header = meta.headers.first().ok_or("an EXR without layers")?;
+        let attributes = &exr_header.own_attributes.other;
+        let header = parse_header(attributes)?;
         let size = header.width as u64 * (header.rows.end - header.rows.start) as u64;
+        // The EXR's own size, checked before its pixels are read: a small
+        // file may claim a huge image.
+        let window = exr_header.layer_size;
+        if (window.width() as u64, window.height() as u64)
+            != (header.width as u64, (header.rows.end - header.rows.start) as u64)
+        {
+            return Err(format!(
+                "its pixels are {}×{}, its header says {}×{}",
+                window.width(),
+                window.height(),
+                header.width,
+                header.rows.end - header.rows.start
+            ));
+        }
+        let channels = exr_header.channels.list.len() as u64;
+        crate::memory::check(
+            format!("reading a {}×{} partial render", header.width, header.rows.end - header.rows.start),
+            size.saturating_mul(channels * 4 + crate::film::ACCUMULATOR_BYTES_PER_PIXEL as u64),
+        )
+        .map_err(|e| e.to_string())?;
         let image = read()
             .no_deep_data()
             .largest_resolution_level()
@@ -136,8 +157,39 @@ impl Partial {
         for (i, p) in pixels.iter_mut().enumerate() {
             p.count = n0[i] as u64 | (n1[i] as u64) << 32;
         }
+        check_sums(&header, sums.pixels())?;
+        if let Some(expected) = header::field(attributes, CHECKSUM_KEY)?
+            && expected != checksum(sums.pixels())
+        {
+            return Err(
+                "its sums do not match their checksum: the file was damaged or edited after it was written".into()
+            );
+        }
         Ok(Partial { header, sums })
     }
+}
+
+/// Every pixel of a part holds its header's samples, no more and no fewer,
+/// and sums of squares, which are never negative: a file that says
+/// otherwise would merge or resume into a wrong image.
+fn check_sums(header: &PartialHeader, pixels: &[PixelSum]) -> Result<(), String> {
+    let samples = header.samples.end - header.samples.start;
+    let width = header.width.max(1) as usize;
+    for (i, p) in pixels.iter().enumerate() {
+        let at = || format!("pixel (x {}, y {})", i % width, header.rows.start as usize + i / width);
+        if p.count != samples {
+            return Err(format!(
+                "{} holds {} samples, its header says {samples} (samples {:?})",
+                at(),
+                p.count,
+                header.samples
+            ));
+        }
+        if p.sum_squares.iter().any(|&s| s < 0) {
+            return Err(format!("{} holds a negative sum of squares, which no render makes", at()));
+        }
+    }
+    Ok(())
 }
 
 /// Writes the sums `sums` with their header as a partial file at `path`,
@@ -147,7 +199,7 @@ impl Partial {
 pub fn write(path: &Path, header: &PartialHeader, sums: &Accumulator) -> io::Result<()> {
     super::write_atomically_with(path, |file| {
         let mut out = io::BufWriter::new(file);
-        encode_into(header, sums, &[(FIELDS_ATTRIBUTE, header_text(header))], &mut out)?;
+        encode_into(header, sums, &[(FIELDS_ATTRIBUTE, fields_text(header, sums))], &mut out)?;
         out.flush()
     })
 }
@@ -159,7 +211,36 @@ pub fn write(path: &Path, header: &PartialHeader, sums: &Accumulator) -> io::Res
 /// compresses them, so that the encoding holds no copy of
 /// the sums (104 bytes a pixel).
 pub fn encode(header: &PartialHeader, sums: &Accumulator) -> io::Result<Vec<u8>> {
-    encode_with_attributes(header, sums, &[(FIELDS_ATTRIBUTE, header_text(header))])
+    encode_with_attributes(header, sums, &[(FIELDS_ATTRIBUTE, fields_text(header, sums))])
+}
+
+/// The header's fields and the checksum of the sums (`sums=`), as the
+/// text of the [`FIELDS_ATTRIBUTE`].
+fn fields_text(header: &PartialHeader, sums: &Accumulator) -> String {
+    format!("{}{CHECKSUM_KEY}={}\n", header_text(header), checksum(sums.pixels()))
+}
+
+/// The key of the sums' checksum among a partial's fields.
+const CHECKSUM_KEY: &str = "sums";
+
+/// A checksum of every pixel's sums and count, in order: 16 hexadecimal
+/// digits of their 64-bit FNV-1a hash (Fowler, Noll and Vo). A part whose
+/// sums were damaged or edited after it was written no longer matches.
+fn checksum(pixels: &[PixelSum]) -> String {
+    let mut hash = 0xcbf2_9ce4_8422_2325u64;
+    let mut eat = |bytes: &[u8]| {
+        for &b in bytes {
+            hash = (hash ^ b as u64).wrapping_mul(0x0000_0100_0000_01b3);
+        }
+    };
+    for p in pixels {
+        eat(&p.count.to_le_bytes());
+        for c in 0..3 {
+            eat(&p.sum[c].to_le_bytes());
+            eat(&p.sum_squares[c].to_le_bytes());
+        }
+    }
+    format!("{hash:016x}")
 }
 
 /// The EXR bytes of the sums with these text attributes in the header.
@@ -337,5 +418,35 @@ mod tests {
         std::fs::write(&path, encode_with_attributes(&p.header, &p.sums, &unknown).unwrap()).unwrap();
         let e = Partial::read(&path).unwrap_err();
         assert!(e.contains("of format `airlight-partial-9`"), "{e}");
+    }
+    /// Sums that disagree with their header (counts of 0, 7 or 2⁶⁴ − 1
+    /// where it says 3 samples; a negative sum of squares) or with their
+    /// checksum are refused, not merged or resumed into a wrong image.
+    #[test]
+    fn sums_that_disagree_with_the_header_or_the_checksum_are_refused() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("p.exr");
+        let refused = |p: &Partial| {
+            p.write(&path).unwrap();
+            Partial::read(&path).unwrap_err()
+        };
+        for count in [0, 7, u64::MAX] {
+            let mut p = part(1..3, 2..5, 7);
+            p.sums.pixels_mut()[4].count = count;
+            let e = refused(&p);
+            assert!(e.contains(&format!("pixel (x 1, y 2) holds {count} samples, its header says 3")), "{e}");
+        }
+        let mut p = part(1..3, 2..5, 7);
+        p.sums.pixels_mut()[0].sum_squares[1] = -1;
+        assert!(refused(&p).contains("negative sum of squares"));
+        // A sum changed after the checksum was taken.
+        let p = part(1..3, 2..5, 7);
+        let mut edited = p.clone();
+        edited.sums.pixels_mut()[2].sum[0] += 1;
+        let fields = format!("{}{CHECKSUM_KEY}={}\n", header_text(&p.header), checksum(p.sums.pixels()));
+        let bytes = encode_with_attributes(&edited.header, &edited.sums, &[(FIELDS_ATTRIBUTE, fields)]).unwrap();
+        std::fs::write(&path, bytes).unwrap();
+        let e = Partial::read(&path).unwrap_err();
+        assert!(e.contains("do not match their checksum"), "{e}");
     }
 }
