@@ -243,6 +243,23 @@ fn sizes_that_do_not_fit_in_memory_are_refused_with_size_and_limit() {
 }
 
 #[test]
+fn a_texture_is_counted_before_it_is_decoded() {
+    // 2048² pixels of 16-bit RGBA: a few kilobytes of PNG that decode to
+    // 32 MiB. Under a 16 MiB limit it is refused before the decoder
+    // allocates, with what it would take.
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    image::ImageBuffer::<image::Rgba<u16>, Vec<u16>>::new(2048, 2048).save(d.join("big.png")).unwrap();
+    assert!(std::fs::metadata(d.join("big.png")).unwrap().len() < 1 << 20);
+    let scene = "[materials.t]\ntype = \"texture\"\nfile = \"big.png\"\n\
+                 [[objects]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\nmaterial = \"t\"\n";
+    std::fs::write(d.join("t.toml"), scene).unwrap();
+    let out = airlight_env(d, &["info", "t.toml"], &[("AIRLIGHT_MEMORY_LIMIT", "16M")]);
+    refused(&out, "decoding a 2048×2048 texture needs about");
+    assert!(airlight_env(d, &["info", "t.toml"], &[("AIRLIGHT_MEMORY_LIMIT", "256M")]).status.success());
+}
+
+#[test]
 fn a_memory_limit_that_is_not_a_size_is_refused() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();

@@ -128,7 +128,13 @@ impl Texture {
         }
         let mut reader = image::ImageReader::with_format(std::io::Cursor::new(bytes), format);
         reader.limits(image::Limits::no_limits());
-        let image = reader.decode().map_err(|e| format!("cannot decode the image: {e}"))?;
+        // The decoded image (16-bit RGBA takes 8 bytes a pixel), its 8-bit
+        // RGB copy and the texels, counted before the decoder allocates.
+        let decoder = reader.into_decoder().map_err(|e| format!("cannot read the image: {e}"))?;
+        let decoded = image::ImageDecoder::total_bytes(&decoder);
+        let needed = decoded.saturating_add(width as u64 * height as u64 * 6);
+        crate::memory::check(format!("decoding a {width}×{height} texture"), needed).map_err(|e| e.to_string())?;
+        let image = image::DynamicImage::from_decoder(decoder).map_err(|e| format!("cannot decode the image: {e}"))?;
         let rgb = image.into_rgb8();
         let texels = rgb.pixels().map(|p| p.0).collect();
         Texture::from_srgb8(width, height, texels).ok_or_else(|| "the image is empty".to_string())

@@ -231,3 +231,49 @@ fn bad_gltf_files_name_the_file_the_json_path_and_the_problem() {
     let e = error(&byte_positions);
     assert!(e.contains("POSITION: accessors[0] is Vec3 of U8"), "{e}");
 }
+
+/// What a glTF file places is held to the scene file's rules, and its
+/// sizes are counted as it places them: a second buffer cannot copy the
+/// BIN chunk, reused nodes cannot multiply without bound, vertices, lights
+/// and cameras must lie within reach of f32, a spot's cone within π/2.
+#[test]
+fn imported_content_obeys_the_scene_files_rules_and_limits() {
+    let dir = tempfile::tempdir().unwrap();
+    let error = |json: &str| {
+        let path = dir.path().join("bad.gltf");
+        std::fs::write(&path, json).unwrap();
+        SceneFile::load(&path).unwrap_err().to_string()
+    };
+    let good = gltf_json(None, "", 4);
+    let far_vertex = good.replace(r#""mesh": 0, "scale": [2, 1, 2]"#, r#""mesh": 0, "scale": [1e10, 1, 2]"#);
+    let e = error(&far_vertex);
+    assert!(e.contains("meshes[0].primitives[0]: the vertex") && e.contains("world units from the origin"), "{e}");
+    let far_light = good.replace(r#""translation": [1, 1, -1]"#, r#""translation": [1e30, 1, -1]"#);
+    let e = error(&far_light);
+    assert!(e.contains("a light at") && e.contains("world units from the origin"), "{e}");
+    let far_camera = good.replace(r#""translation": [0.3, 1, -3]"#, r#""translation": [0.3, 1e30, -3]"#);
+    let e = error(&far_camera);
+    assert!(e.contains("the camera at") && e.contains("world units from the origin"), "{e}");
+    let wide_spot = good.replace(
+        r#"{ "type": "point", "color": [1, 0.5, 0.25], "intensity": 1366 }"#,
+        r#"{ "type": "spot", "color": [1, 0.5, 0.25], "intensity": 1366, "spot": { "outerConeAngle": 1000000 } }"#,
+    );
+    let e = error(&wide_spot);
+    assert!(e.contains("a spot's cone angles must satisfy 0 ≤ inner ≤ outer ≤ π/2"), "{e}");
+    // A node whose children are [k + 1, k + 1], 30 levels: 2³⁰ placements
+    // from a kilobyte.
+    let mut nodes: Vec<String> = (0..30).map(|k| format!(r#"{{ "children": [{}, {}] }}"#, k + 1, k + 1)).collect();
+    nodes.push(r#"{ "name": "leaf" }"#.into());
+    let doubling = format!(
+        r#"{{ "asset": {{ "version": "2.0" }}, "scene": 0, "scenes": [{{ "nodes": [0] }}], "nodes": [{}] }}"#,
+        nodes.join(", ")
+    );
+    let e = error(&doubling);
+    assert!(e.contains("the node hierarchy places more than 1048576 nodes"), "{e}");
+    // Only the first buffer may be a GLB's BIN chunk (each other one
+    // without a uri copied all of it).
+    let second_bin = good.replace(" }],\n  \"bufferViews\"", " }, { \"byteLength\": 4 }],\n  \"bufferViews\"");
+    assert_ne!(second_bin, good);
+    let e = error(&second_bin);
+    assert!(e.contains("buffers[1]: has no uri; only buffers[0] may be the GLB's BIN chunk"), "{e}");
+}

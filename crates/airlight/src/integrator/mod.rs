@@ -5,8 +5,8 @@
 
 mod ambient_occlusion;
 pub mod analytic;
-mod batch;
 mod direct;
+mod direct_batch;
 pub mod equiangular;
 mod light_lanes;
 mod options;
@@ -18,9 +18,9 @@ mod stochastic;
 pub use crate::radiosity::{DEFAULT_LINK_THRESHOLD, RadiosityOptions};
 pub use ambient_occlusion::{AmbientOcclusion, AmbientOcclusionOptions};
 pub use analytic::{Analytic, AnalyticOptions};
-pub(crate) use batch::DeferredShadows;
-pub use batch::first_surface_batch;
 pub use direct::Direct;
+pub(crate) use direct_batch::DeferredShadows;
+pub use direct_batch::first_surface_batch;
 pub use equiangular::Equiangular;
 pub use options::{
     INTEGRATOR_OPTIONS, IntegratorDesc, IntegratorError, IntegratorOption, MAX_BOUNCES, MAX_DEPTH, MAX_LIGHT_STEPS,

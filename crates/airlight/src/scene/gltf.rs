@@ -35,6 +35,11 @@ pub const LUMINOUS_EFFICACY: f32 = 683.0;
 /// Deepest node hierarchy followed (a cycle would otherwise never end).
 const MAX_DEPTH: usize = 256;
 
+/// Most nodes a scene's hierarchy may place, reused ones counted each
+/// time: a node whose children are `[k + 1, k + 1]` thirty levels deep
+/// places 2³⁰ of them from a kilobyte of text.
+const MAX_PLACED_NODES: u64 = 1 << 20;
+
 /// What a glTF file adds to a scene.
 pub(super) struct Imported {
     pub built: Built,
@@ -75,14 +80,12 @@ impl Checker<'_> {
                 gltf.default_scene().or_else(|| gltf.scenes().next()).ok_or_else(|| fail("it holds no scene".into()))?
             }
         };
-        // Memory: every primitive's triangles, counted before any is read.
-        let triangles: u64 = gltf
-            .meshes()
-            .flat_map(|m| m.primitives())
-            .map(|p| p.indices().or_else(|| p.get(&gltf::Semantic::Positions)).map_or(0, |a| a.count() as u64 / 3))
-            .sum();
-        let needed = self.mesh_bytes.get() + triangles.saturating_mul(super::obj::BYTES_PER_TRIANGLE + 36);
-        crate::memory::check(format!("the scene's meshes ({triangles} triangles in this glTF)"), needed)
+        // Memory: the triangles of every mesh each time a node places it,
+        // counted before any is read (a mesh may be placed many times).
+        let triangles = placed_triangles(&scene).map_err(&fail)?;
+        let needed =
+            self.mesh_bytes.get().saturating_add(triangles.saturating_mul(super::obj::BYTES_PER_TRIANGLE + 36));
+        crate::memory::check(format!("the scene's meshes ({triangles} triangles placed by this glTF)"), needed)
             .map_err(|e| fail(e.to_string()))?;
         self.mesh_bytes.set(needed);
 
@@ -117,13 +120,17 @@ impl Checker<'_> {
         Ok(out)
     }
 
-    /// Each buffer's bytes: the GLB's BIN chunk, a data URI, or a file
-    /// beside the glTF file.
+    /// Each buffer's bytes: the GLB's BIN chunk (the first buffer's only, as
+    /// the specification says: each other one would be a copy of it), a
+    /// data URI, or a file beside the glTF file (its URI percent-decoded).
     fn gltf_buffers(&self, gltf: &gltf::Gltf, file: &Path) -> std::result::Result<Vec<Vec<u8>>, String> {
         let mut buffers = Vec::new();
         for buffer in gltf.buffers() {
             let at = format!("buffers[{}]", buffer.index());
             let data = match buffer.source() {
+                gltf::buffer::Source::Bin if buffer.index() != 0 => {
+                    return Err(format!("{at}: has no uri; only buffers[0] may be the GLB's BIN chunk"));
+                }
                 gltf::buffer::Source::Bin => {
                     gltf.blob.clone().ok_or_else(|| format!("{at}: refers to a BIN chunk the file does not have"))?
                 }
@@ -135,6 +142,7 @@ impl Checker<'_> {
                         .map_err(|e| format!("{at}: its data URI is not valid base64: {e}"))?
                 }
                 gltf::buffer::Source::Uri(uri) => {
+                    let uri = &percent_decoded(uri);
                     let beside = file.parent().unwrap_or(Path::new("")).join(uri);
                     let path = self.assets.resolve(&beside.to_string_lossy()).map_err(|why| format!("{at}: {why}"))?;
                     let data = read_limited(&path, MAX_MESH_BYTES).map_err(|why| format!("{at}: `{uri}`: {why}"))?;
@@ -185,6 +193,10 @@ impl Checker<'_> {
                 .collect();
             if let Some(p) = positions.iter().find(|p| !p.is_finite()) {
                 return Err(format!("{at}: a vertex is not finite once placed: {p}"));
+            }
+            // The scene file's rule for every point: within reach of f32.
+            if let Some(p) = positions.iter().find(|p| p.abs().max_element() > super::limits::MAX_COORDINATE) {
+                return Err(super::limits::too_far(&format!("{at}: the vertex {p}"), p.abs().max_element()));
             }
             let indices: Vec<u32> = match reader.read_indices() {
                 Some(indices) => indices.into_u32().collect(),
@@ -417,6 +429,33 @@ fn fits(accessor: &gltf::Accessor, buffers: &[Vec<u8>]) -> std::result::Result<(
     Ok(())
 }
 
+/// The triangles the scene's nodes place, a mesh counted each time a node
+/// places it; refuses a hierarchy deeper than [`MAX_DEPTH`] or placing
+/// more than [`MAX_PLACED_NODES`] nodes, before anything is read.
+fn placed_triangles(scene: &gltf::Scene) -> std::result::Result<u64, String> {
+    let mut stack: Vec<(gltf::Node, usize)> = scene.nodes().map(|n| (n, 0)).collect();
+    let (mut placed, mut triangles) = (0u64, 0u64);
+    while let Some((node, depth)) = stack.pop() {
+        placed += 1;
+        if depth > MAX_DEPTH {
+            return Err(format!("nodes[{}]: the node hierarchy is deeper than {MAX_DEPTH} (a cycle?)", node.index()));
+        }
+        if placed > MAX_PLACED_NODES {
+            return Err(format!(
+                "the node hierarchy places more than {MAX_PLACED_NODES} nodes (nodes reused as children of many)"
+            ));
+        }
+        if let Some(mesh) = node.mesh() {
+            let count = |p: gltf::Primitive| {
+                p.indices().or_else(|| p.get(&gltf::Semantic::Positions)).map_or(0, |a| a.count() as u64 / 3)
+            };
+            triangles = triangles.saturating_add(mesh.primitives().map(count).sum());
+        }
+        stack.extend(node.children().map(|c| (c, depth + 1)));
+    }
+    Ok(triangles)
+}
+
 /// A `KHR_lights_punctual` light placed by its node: it shines along the
 /// node's −Z; colour × intensity, in candela (lux for a sun), over
 /// [`LUMINOUS_EFFICACY`]. A spot's outer cone is Airlight's `cone_angle`,
@@ -428,15 +467,25 @@ fn gltf_light(light: &gltf::khr_lights_punctual::Light, world: Affine3A) -> std:
         return Err(format!("a light's colour × intensity is not finite and ≥ 0: {power}"));
     }
     let position = world.transform_point3(Vec3::ZERO);
+    if !position.is_finite() || position.abs().max_element() > super::limits::MAX_COORDINATE {
+        return Err(super::limits::too_far(&format!("a light at {position}"), position.abs().max_element()));
+    }
     let direction = world.transform_vector3(Vec3::NEG_Z).try_normalize().ok_or("a light's node has no direction")?;
     use gltf::khr_lights_punctual::Kind;
     Ok(match light.kind() {
         Kind::Point => Light::point(position, power),
         Kind::Directional => Light::distant(direction, power),
         Kind::Spot { inner_cone_angle, outer_cone_angle } => {
-            if !(outer_cone_angle > 0.0 && inner_cone_angle >= 0.0 && inner_cone_angle <= outer_cone_angle) {
+            // The extension's rule: 0 ≤ inner < outer ≤ π/2.
+            let quarter = std::f32::consts::FRAC_PI_2;
+            if !(outer_cone_angle > 0.0
+                && outer_cone_angle <= quarter
+                && inner_cone_angle >= 0.0
+                && inner_cone_angle <= outer_cone_angle)
+            {
                 return Err(format!(
-                    "a spot's cone angles must satisfy 0 ≤ inner ≤ outer, outer > 0: {inner_cone_angle}, {outer_cone_angle}"
+                    "a spot's cone angles must satisfy 0 ≤ inner ≤ outer ≤ π/2, outer > 0: {inner_cone_angle}, \
+                     {outer_cone_angle}"
                 ));
             }
             Light::Spot {
@@ -456,6 +505,9 @@ fn gltf_light(light: &gltf::khr_lights_punctual::Light, world: Affine3A) -> std:
 /// Airlight's vertical `fov`, twice `ymag` its orthographic `view_height`.
 fn gltf_camera(camera: &gltf::Camera, world: Affine3A) -> std::result::Result<(Camera, Option<f32>), String> {
     let position = world.transform_point3(Vec3::ZERO);
+    if !position.is_finite() || position.abs().max_element() > super::limits::MAX_COORDINATE {
+        return Err(super::limits::too_far(&format!("the camera at {position}"), position.abs().max_element()));
+    }
     let forward = world.transform_vector3(Vec3::NEG_Z).try_normalize().ok_or("the camera's node has no direction")?;
     let up = world.transform_vector3(Vec3::Y).try_normalize().ok_or("the camera's node has no up direction")?;
     Ok(match camera.projection() {
