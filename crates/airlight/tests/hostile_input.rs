@@ -233,3 +233,20 @@ fn a_medium_too_thick_for_any_image_is_refused_not_tracked_forever() {
     }
     assert!(image(&scene("0.5")).mean().x > 0.0);
 }
+
+#[test]
+fn a_focus_beyond_the_scenes_reach_is_refused_not_rendered_black() {
+    // 1e20 squared overflows f32: every lens ray was lost and the image
+    // black, while 1e19 rendered.
+    let scene = |focus: &str| {
+        format!(
+            "[render]\nwidth = 8\nheight = 6\nspp = 2\n[camera]\nposition = [0, 1, -4]\nlook_at = [0, 0, 0]\n\
+             aperture = 0.1\nfocus_distance = {focus}\n{TAIL}\
+             [[objects]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\nmaterial = \"m\"\n\
+             [[lights]]\ntype = \"point\"\nposition = [0, 3, -3]\nintensity = 10\n"
+        )
+    };
+    let e = load(&scene("1e20")).unwrap_err();
+    assert!(e.contains("camera.focus_distance must be at most 1e9"), "{e}");
+    assert!(image(&scene("1e9")).mean().x > 0.0);
+}

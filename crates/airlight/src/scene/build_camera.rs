@@ -89,6 +89,19 @@ impl Checker<'_> {
         let aperture = self.non_negative(span.clone(), "camera.aperture", c.aperture.unwrap_or(0.0))?;
         let focus = c.focus_distance.unwrap_or(forward.length());
         let focus = self.positive(span.clone(), "camera.focus_distance", focus)?;
+        // Beyond the scene's reach a focus is at infinity; far beyond it its
+        // square overflows f32 and every lens ray is lost.
+        if focus > super::limits::MAX_COORDINATE {
+            return Err(self.err_field(
+                span,
+                "focus_distance",
+                format!(
+                    "camera.focus_distance must be at most {:e}, the scene's reach (a focus that far is at \
+                     infinity), got {focus:e}",
+                    super::limits::MAX_COORDINATE
+                ),
+            ));
+        }
         let camera = Camera::oriented(position, look_at, up, projection).with_lens(aperture, focus);
         if ![camera.forward, camera.right, camera.up].iter().all(|v| v.is_finite() && v.is_normalized()) {
             return Err(self.err(span, "the camera's view direction and up do not frame an image in 32-bit floats"));
