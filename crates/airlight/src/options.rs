@@ -378,6 +378,41 @@ pub fn flag(key: &str) -> String {
     format!("--{}", key.replace('_', "-"))
 }
 
+/// Checks every table of declarations takes: each option set to a value
+/// other than its default reads back as that value (a `get` that reads
+/// another field than `set` writes fails) and back to its default on
+/// request; each listed name is known to its type, an unlisted one
+/// refused.
+#[cfg(test)]
+pub(crate) fn check_declarations<'a, T: Default + PartialEq + fmt::Debug + 'static>(
+    specs: impl IntoIterator<Item = &'a OptionSpec<T>>,
+) {
+    for spec in specs {
+        let default = T::default();
+        let value = match spec.kind {
+            ValueKind::Bool => OptionValue::Bool((spec.get)(&default) != OptionValue::Bool(true)),
+            ValueKind::Count { min, .. } => OptionValue::Int(min as i128 + 3),
+            ValueKind::Number(_) => OptionValue::Float(0.375),
+            ValueKind::Colour => OptionValue::List(vec![0.25, 0.5, 0.75]),
+            ValueKind::Name(names) => OptionValue::Text(names[names.len() - 1].into()),
+        };
+        let mut t = T::default();
+        spec.apply(&mut t, &value).unwrap_or_else(|e| panic!("{}: {e}", spec.key));
+        assert_eq!((spec.get)(&t), value, "{}", spec.key);
+        assert_ne!(t, default, "{} changed nothing", spec.key);
+        spec.apply(&mut t, &OptionValue::Default).unwrap();
+        assert_eq!((spec.get)(&t), (spec.get)(&default), "{} back to its default", spec.key);
+        if let ValueKind::Name(names) = spec.kind {
+            for name in names {
+                let mut t = T::default();
+                spec.apply(&mut t, &OptionValue::Text((*name).into())).unwrap();
+                assert_eq!((spec.get)(&t), OptionValue::Text((*name).into()), "{}", spec.key);
+            }
+            assert!(spec.apply(&mut T::default(), &OptionValue::Text("nonesuch".into())).is_err(), "{}", spec.key);
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

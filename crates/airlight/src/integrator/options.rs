@@ -403,40 +403,8 @@ mod tests {
     }
 
     #[test]
-    fn each_option_reads_back_what_it_was_set_to() {
-        // Set each option to a value other than its default and read it
-        // back: a `get` that reads another field than `set` writes fails.
-        for o in INTEGRATOR_OPTIONS {
-            let spec = &o.spec;
-            let value = match spec.kind {
-                ValueKind::Bool => OptionValue::Bool((spec.get)(&IntegratorDesc::default()) != OptionValue::Bool(true)),
-                ValueKind::Count { min, .. } => OptionValue::Int(min as i128 + 2),
-                ValueKind::Number(_) => OptionValue::Float(0.375),
-                ValueKind::Colour => OptionValue::List(vec![0.25, 0.5, 0.75]),
-                ValueKind::Name(names) => OptionValue::Text(names[names.len() - 1].into()),
-            };
-            let mut d = IntegratorDesc::default();
-            spec.apply(&mut d, &value).unwrap_or_else(|e| panic!("{}: {e}", spec.key));
-            assert_eq!((spec.get)(&d), value, "{}", spec.key);
-            assert_ne!(d, IntegratorDesc::default(), "{} changed nothing", spec.key);
-            spec.apply(&mut d, &OptionValue::Default).unwrap();
-            assert_eq!((spec.get)(&d), (spec.get)(&IntegratorDesc::default()), "{} back to its default", spec.key);
-        }
-    }
-
-    #[test]
-    fn every_listed_name_is_known_to_its_type() {
-        for o in INTEGRATOR_OPTIONS {
-            if let ValueKind::Name(names) = o.spec.kind {
-                for name in names {
-                    let mut d = IntegratorDesc::default();
-                    o.spec.apply(&mut d, &OptionValue::Text((*name).into())).unwrap();
-                    assert_eq!((o.spec.get)(&d), OptionValue::Text((*name).into()));
-                }
-                let e = o.spec.apply(&mut IntegratorDesc::default(), &OptionValue::Text("nonesuch".into()));
-                assert!(e.is_err(), "{}", o.spec.key);
-            }
-        }
+    fn each_option_reads_back_what_it_was_set_to_and_knows_its_names() {
+        crate::options::check_declarations(INTEGRATOR_OPTIONS.iter().map(|o| &o.spec));
     }
 
     #[test]

@@ -222,33 +222,7 @@ mod tests {
     use super::*;
 
     #[test]
-    fn each_setting_reads_back_what_it_was_set_to() {
-        for spec in RENDER_SETTINGS {
-            let value = match spec.kind {
-                ValueKind::Bool => OptionValue::Bool((spec.get)(&RenderSettings::default()) != OptionValue::Bool(true)),
-                ValueKind::Count { min, .. } => OptionValue::Int(min as i128 + 3),
-                ValueKind::Number(_) => OptionValue::Float(0.375),
-                ValueKind::Colour => OptionValue::List(vec![0.25, 0.5, 0.75]),
-                ValueKind::Name(names) => OptionValue::Text(names[names.len() - 1].into()),
-            };
-            let mut s = RenderSettings::default();
-            spec.apply(&mut s, &value).unwrap_or_else(|e| panic!("{}: {e}", spec.key));
-            assert_eq!((spec.get)(&s), value, "{}", spec.key);
-            assert_ne!(s, RenderSettings::default(), "{} changed nothing", spec.key);
-        }
-    }
-
-    #[test]
-    fn every_listed_name_is_known_to_its_type() {
-        for spec in RENDER_SETTINGS {
-            if let ValueKind::Name(names) = spec.kind {
-                for name in names {
-                    let mut s = RenderSettings::default();
-                    spec.apply(&mut s, &OptionValue::Text((*name).into())).unwrap();
-                    assert_eq!((spec.get)(&s), OptionValue::Text((*name).into()));
-                }
-                assert!(spec.apply(&mut RenderSettings::default(), &OptionValue::Text("nonesuch".into())).is_err());
-            }
-        }
+    fn each_setting_reads_back_what_it_was_set_to_and_knows_its_names() {
+        crate::options::check_declarations(RENDER_SETTINGS);
     }
 }
