@@ -277,3 +277,23 @@ fn imported_content_obeys_the_scene_files_rules_and_limits() {
     let e = error(&second_bin);
     assert!(e.contains("buffers[1]: has no uri; only buffers[0] may be the GLB's BIN chunk"), "{e}");
 }
+
+/// An include's tiny scale keeps its lights' and camera's directions
+/// (normalised in 64-bit floats, as the scene file's are); a huge one puts
+/// its vertices out of reach, and says so.
+#[test]
+fn an_includes_extreme_scale_is_refused_or_kept_as_the_file_would() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("room.gltf"), gltf_json(None, "", 4)).unwrap();
+    let load = |scale: &str| {
+        let path = dir.path().join("s.toml");
+        std::fs::write(&path, format!("[[include]]\nfile = \"room.gltf\"\nscale = {scale}\n")).unwrap();
+        SceneFile::load(&path).map_err(|e| e.to_string())
+    };
+    let e = load("1e30").unwrap_err();
+    assert!(e.contains("world units from the origin"), "{e}");
+    let (tiny, whole) = (load("1e-30").unwrap(), load("1").unwrap());
+    let (a, b) = (tiny.scene.camera().forward, whole.scene.camera().forward);
+    assert!((a - b).length() < 1e-6, "{a} against {b}");
+    assert!(tiny.scene.lights().iter().any(|l| matches!(l, airlight::light::Light::Point { .. })));
+}

@@ -429,6 +429,14 @@ fn fits(accessor: &gltf::Accessor, buffers: &[Vec<u8>]) -> std::result::Result<(
     Ok(())
 }
 
+/// A node's axis in world space, normalised in 64-bit floats as the scene
+/// file's directions are, so that a tiny scale (an include's `scale =
+/// 1e-30`) keeps its direction; None when the transform flattens it.
+fn node_axis(world: Affine3A, axis: Vec3) -> Option<Vec3> {
+    // (An f32's square cannot underflow an f64.)
+    world.transform_vector3(axis).as_dvec3().try_normalize().map(|d| d.as_vec3())
+}
+
 /// The triangles the scene's nodes place, a mesh counted each time a node
 /// places it; refuses a hierarchy deeper than [`MAX_DEPTH`] or placing
 /// more than [`MAX_PLACED_NODES`] nodes, before anything is read.
@@ -470,7 +478,7 @@ fn gltf_light(light: &gltf::khr_lights_punctual::Light, world: Affine3A) -> std:
     if !position.is_finite() || position.abs().max_element() > super::limits::MAX_COORDINATE {
         return Err(super::limits::too_far(&format!("a light at {position}"), position.abs().max_element()));
     }
-    let direction = world.transform_vector3(Vec3::NEG_Z).try_normalize().ok_or("a light's node has no direction")?;
+    let direction = node_axis(world, Vec3::NEG_Z).ok_or("a light's node has no direction")?;
     use gltf::khr_lights_punctual::Kind;
     Ok(match light.kind() {
         Kind::Point => Light::point(position, power),
@@ -508,8 +516,8 @@ fn gltf_camera(camera: &gltf::Camera, world: Affine3A) -> std::result::Result<(C
     if !position.is_finite() || position.abs().max_element() > super::limits::MAX_COORDINATE {
         return Err(super::limits::too_far(&format!("the camera at {position}"), position.abs().max_element()));
     }
-    let forward = world.transform_vector3(Vec3::NEG_Z).try_normalize().ok_or("the camera's node has no direction")?;
-    let up = world.transform_vector3(Vec3::Y).try_normalize().ok_or("the camera's node has no up direction")?;
+    let forward = node_axis(world, Vec3::NEG_Z).ok_or("the camera's node has no direction")?;
+    let up = node_axis(world, Vec3::Y).ok_or("the camera's node has no up direction")?;
     Ok(match camera.projection() {
         gltf::camera::Projection::Perspective(p) => {
             let fov = p.yfov().to_degrees();
