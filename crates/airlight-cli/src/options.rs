@@ -5,7 +5,7 @@
 //! option's doc line; its value is checked by the option's own check as
 //! clap reads it.
 
-use airlight::integrator::{INTEGRATOR_OPTIONS, IntegratorDesc, IntegratorKind, IntegratorOption};
+use airlight::integrator::{INTEGRATOR_KEY, INTEGRATOR_OPTIONS, IntegratorDesc, IntegratorKind, IntegratorOption};
 use airlight::options::{OptionError, OptionSpec, OptionValue, ValueKind, flag};
 use airlight::scene::{RENDER_SETTINGS, RenderSettings};
 use clap::builder::PossibleValuesParser;
@@ -35,7 +35,7 @@ pub struct RadiosityFlags;
 
 impl FlagSet for RadiosityFlags {
     fn takes(option: &IntegratorOption) -> bool {
-        option.spec.key != "integrator" && option.takes.contains(&IntegratorKind::Radiosity)
+        option.spec.key != INTEGRATOR_KEY && option.takes.contains(&IntegratorKind::Radiosity)
     }
 }
 
@@ -93,7 +93,7 @@ fn flag_spec<T: Default>(o: &OptionSpec<T>, takes: Option<String>) -> FlagSpec {
 fn flag_specs<S: FlagSet>() -> Vec<(FlagSpec, &'static str)> {
     let film = RENDER_SETTINGS.iter().map(|o| (flag_spec(o, None), "Film and sampling"));
     let integrators = INTEGRATOR_OPTIONS.iter().filter(|o| S::takes(o)).map(|o| {
-        let takes = (o.spec.key != "integrator").then(|| {
+        let takes = (o.spec.key != INTEGRATOR_KEY).then(|| {
             let names: Vec<&str> = o.takes.iter().map(|k| k.name()).collect();
             names.join(", ")
         });

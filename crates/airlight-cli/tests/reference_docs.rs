@@ -7,7 +7,7 @@
 //! --test-threads=1` writes them anew.
 
 use airlight::SceneFile;
-use airlight::integrator::{INTEGRATOR_OPTIONS, IntegratorKind};
+use airlight::integrator::{INTEGRATOR_KEY, INTEGRATOR_OPTIONS, IntegratorKind};
 use airlight::options::{NumberRange, OptionSpec, ValueKind};
 use airlight::scene::RENDER_SETTINGS;
 use std::path::{Path, PathBuf};
@@ -69,7 +69,7 @@ fn stub_keywords() -> String {
     let mut out = String::new();
     let kinds = RENDER_SETTINGS.iter().map(|s| (s.key, s.kind));
     let kinds = kinds.chain(INTEGRATOR_OPTIONS.iter().map(|o| (o.spec.key, o.spec.kind)));
-    for (key, kind) in kinds.filter(|(k, _)| *k != "integrator") {
+    for (key, kind) in kinds.filter(|(k, _)| *k != INTEGRATOR_KEY) {
         out += &format!("        {key}: {} | None = None,\n", python_type(kind));
     }
     out

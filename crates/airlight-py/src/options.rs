@@ -4,7 +4,7 @@
 //! keys, bounds and messages are the file's and the CLI's.
 
 use crate::errors::integrator_error;
-use airlight::integrator::{IntegratorDesc, IntegratorKind};
+use airlight::integrator::{INTEGRATOR_KEY, IntegratorDesc, IntegratorKind};
 use airlight::options::{OptionError, OptionValue, ValueKind};
 use airlight::scene::{RENDER_SETTINGS, RenderSettings};
 use pyo3::exceptions::{PyTypeError, PyValueError};
@@ -97,7 +97,7 @@ fn refusal(e: OptionError, integrator_option: bool) -> PyErr {
 /// Every option `render()` takes by keyword, as the scene file's `[render]`
 /// spells it, but the integrator (its own argument).
 pub fn keywords() -> Vec<&'static str> {
-    airlight::SceneFile::render_keys().filter(|k| *k != "integrator").collect()
+    airlight::SceneFile::render_keys().filter(|k| *k != INTEGRATOR_KEY).collect()
 }
 
 /// The settings and integrator description `render()`'s arguments give:
@@ -119,7 +119,7 @@ pub fn apply(
     for (key, v) in options {
         if let Some(spec) = airlight::options::find(RENDER_SETTINGS, key) {
             spec.apply(&mut s, &value(spec.kind, key, v)?).map_err(|e| refusal(e, false))?;
-        } else if let Some(o) = IntegratorDesc::option(key).filter(|o| o.spec.key != "integrator") {
+        } else if let Some(o) = IntegratorDesc::option(key).filter(|o| o.spec.key != INTEGRATOR_KEY) {
             o.spec.apply(&mut d, &value(o.spec.kind, key, v)?).map_err(|e| refusal(e, true))?;
         } else {
             return Err(PyTypeError::new_err(format!(

@@ -23,8 +23,8 @@ pub(crate) use direct_batch::DeferredShadows;
 pub use direct_batch::first_surface_batch;
 pub use equiangular::Equiangular;
 pub use options::{
-    INTEGRATOR_OPTIONS, IntegratorDesc, IntegratorError, IntegratorOption, MAX_BOUNCES, MAX_DEPTH, MAX_LIGHT_STEPS,
-    MAX_STEPS, OptionError, PathOptions, RaymarchOptions, StochasticOptions,
+    INTEGRATOR_KEY, INTEGRATOR_OPTIONS, IntegratorDesc, IntegratorError, IntegratorOption, MAX_BOUNCES, MAX_DEPTH,
+    MAX_LIGHT_STEPS, MAX_STEPS, OptionError, PathOptions, RaymarchOptions, StochasticOptions,
 };
 pub use path::PathTracer;
 pub use radiosity::{RadiosityIntegrator, indirect_radiance};

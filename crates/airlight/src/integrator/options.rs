@@ -136,11 +136,16 @@ fn count(n: u32) -> OptionValue {
     OptionValue::Int(n as i128)
 }
 
+/// The key of the option that names the integrator: the one option every
+/// integrator takes, and the one front ends give a place of its own
+/// (Python's first argument).
+pub const INTEGRATOR_KEY: &str = "integrator";
+
 /// Every integrator option, in the order the docs list them.
 pub const INTEGRATOR_OPTIONS: &[IntegratorOption] = &[
     IntegratorOption {
         spec: OptionSpec {
-            key: "integrator",
+            key: INTEGRATOR_KEY,
             kind: ValueKind::Name(&IntegratorKind::NAMES),
             unit: "",
             doc: "The integrator that renders the image.",
@@ -410,7 +415,7 @@ mod tests {
     #[test]
     fn every_integrator_but_direct_takes_an_option_of_its_own() {
         for kind in IntegratorKind::ALL {
-            let own = INTEGRATOR_OPTIONS.iter().filter(|o| o.spec.key != "integrator" && o.takes.contains(&kind));
+            let own = INTEGRATOR_OPTIONS.iter().filter(|o| o.spec.key != INTEGRATOR_KEY && o.takes.contains(&kind));
             assert_eq!(own.count() == 0, kind == IntegratorKind::Direct, "{kind}");
         }
     }
