@@ -73,6 +73,23 @@ fn render_never_replaces_its_scene_or_writes_two_outputs_to_one_file() {
     assert_eq!(files(d), ["foo.png", "s.exr"], "nothing written");
 }
 
+#[test]
+fn frames_written_into_a_folder_never_replace_an_input() {
+    // A scene file named as the first frame, in the folder the frames go to.
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let original = scene_text("cornell_box.toml");
+    std::fs::write(d.join("frame_0000.png"), &original).unwrap();
+    let gi = airlight(d, &["gi", "frame_0000.png", "--frames", "2", "--output-dir", "."]);
+    refused(&gi, "--output-dir `.`: its `frame_0000.png` would replace an input");
+    std::fs::write(d.join("frame_0001.exr"), &original).unwrap();
+    let view = ["view", "frame_0001.exr", "--headless", "--frames", "3", "--out", ".", "--width", "8", "--height", "6"];
+    refused(&airlight(d, &view), "--out `.`: its `frame_0001.exr` would replace an input");
+    assert_eq!(std::fs::read_to_string(d.join("frame_0000.png")).unwrap(), original);
+    assert_eq!(std::fs::read_to_string(d.join("frame_0001.exr")).unwrap(), original);
+    assert_eq!(files(d), ["frame_0000.png", "frame_0001.exr"], "nothing written");
+}
+
 /// Runs `args` for at most `limit`; the output, or None if it had to be killed.
 fn bounded(dir: &Path, args: &[&str], limit: Duration) -> Option<Output> {
     let mut child: Child = Command::new(env!("CARGO_BIN_EXE_airlight"))
