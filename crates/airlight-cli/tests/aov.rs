@@ -2,7 +2,8 @@
 //! of the EXR output, with the channel names compositors read, checked by
 //! reading the file back with the `exr` crate.
 
-use std::collections::HashMap;
+mod common;
+
 use std::path::Path;
 use std::process::{Command, Output};
 
@@ -43,18 +44,6 @@ position = [1, 2, 1]
 intensity = 5
 "#;
 
-/// Every channel of the file's first layer, by name.
-fn channels(path: &Path) -> HashMap<String, Vec<f32>> {
-    use exr::prelude::*;
-    let image = read().no_deep_data().largest_resolution_level().all_channels().first_valid_layer().all_attributes();
-    let image = image.from_file(path).unwrap();
-    let mut out = HashMap::new();
-    for c in &image.layer_data.channel_data.list {
-        out.insert(c.name.to_string(), c.sample_data.values_as_f32().collect());
-    }
-    out
-}
-
 #[test]
 fn aovs_are_layers_of_the_exr_with_standard_names() {
     let dir = tempfile::tempdir().unwrap();
@@ -66,7 +55,7 @@ fn aovs_are_layers_of_the_exr_with_standard_names() {
     assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
     let plain = airlight(dir.path(), &["render", "s.toml", "--progressive", "-o", "plain.exr", "-q"]);
     assert!(plain.status.success());
-    let with = channels(&dir.path().join("out.exr"));
+    let with = common::exr_channels(&dir.path().join("out.exr"));
     let mut names: Vec<&str> = with.keys().map(String::as_str).collect();
     names.sort();
     assert_eq!(
@@ -88,7 +77,7 @@ fn aovs_are_layers_of_the_exr_with_standard_names() {
         ]
     );
     // The image is the render's, AOVs or not.
-    let without = channels(&dir.path().join("plain.exr"));
+    let without = common::exr_channels(&dir.path().join("plain.exr"));
     for c in ["R", "G", "B"] {
         assert_eq!(with[c], without[c], "channel {c}");
     }
@@ -147,7 +136,7 @@ fn the_in_scattered_light_is_a_layer_for_single_scattering_integrators() {
             .concat(),
     );
     assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
-    let c = channels(&dir.path().join("fog.exr"));
+    let c = common::exr_channels(&dir.path().join("fog.exr"));
     let mut names: Vec<&str> = c.keys().map(String::as_str).collect();
     names.sort();
     assert_eq!(names, ["B", "G", "R", "Z", "inscatter.B", "inscatter.G", "inscatter.R"]);

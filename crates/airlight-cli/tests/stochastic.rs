@@ -1,5 +1,7 @@
 //! `airlight render` with the stochastic integrator's options.
 
+mod common;
+
 use std::path::Path;
 use std::process::{Command, Output};
 
@@ -53,15 +55,6 @@ position = [0.3, 0.2, 0]
 intensity = 10
 "#;
 
-/// The red channel of an EXR's first layer.
-fn red(path: &Path) -> Vec<f64> {
-    use exr::prelude::*;
-    let image = read().no_deep_data().largest_resolution_level().all_channels().first_valid_layer().all_attributes();
-    let image = image.from_file(path).unwrap();
-    let channel = image.layer_data.channel_data.list.iter().find(|c| c.name.to_string() == "R").unwrap();
-    channel.sample_data.values_as_f32().map(f64::from).collect()
-}
-
 #[test]
 fn sampling_option_is_checked_and_each_choice_is_unbiased_with_its_own_noise() {
     let dir = tempfile::tempdir().unwrap();
@@ -77,8 +70,8 @@ fn sampling_option_is_checked_and_each_choice_is_unbiased_with_its_own_noise() {
         let args = ["render", "fog.toml", "--sampling", sampling, "--no-stratify", "-q", "-o", &image, "--variance"];
         let run = airlight(dir.path(), &[&args[..], &[&variance]].concat());
         assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
-        let sum: f64 = red(&dir.path().join(&image)).iter().sum();
-        let var: f64 = red(&dir.path().join(&variance)).iter().sum();
+        let sum: f64 = common::exr_channels(&dir.path().join(&image))["R"].iter().map(|&v| v as f64).sum();
+        let var: f64 = common::exr_channels(&dir.path().join(&variance))["R"].iter().map(|&v| v as f64).sum();
         assert!(sum > 0.0 && var > 0.0, "{sampling}: {sum} {var}");
         sums.push((sampling, sum, var));
     }

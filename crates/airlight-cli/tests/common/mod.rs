@@ -32,3 +32,15 @@ pub fn tools_present(test: &str, tools: &[&str], install: &str) -> bool {
     eprintln!("SKIPPED: {message}");
     false
 }
+
+/// Every channel of the file's first layer, by name.
+pub fn exr_channels(path: &Path) -> std::collections::HashMap<String, Vec<f32>> {
+    use exr::prelude::*;
+    let image = read().no_deep_data().largest_resolution_level().all_channels().first_valid_layer().all_attributes();
+    let image = image.from_file(path).unwrap();
+    let mut out = std::collections::HashMap::new();
+    for c in &image.layer_data.channel_data.list {
+        out.insert(c.name.to_string(), c.sample_data.values_as_f32().collect());
+    }
+    out
+}
