@@ -88,13 +88,21 @@ fn bad_grid_files_and_keys_are_scene_errors() {
         (grid("missing.vol"), 4, "no file `missing.vol` in the scene's folder"),
         (grid("../x.vol"), 4, "must be a relative path"),
         (grid("cloud.vdb"), 4, "must be a Mitsuba volume ending in .vol"),
-        ("type = \"grid\"\nsigma_s = 1".into(), 1, "a `grid` medium needs `file`"),
-        (format!("{}\nbase = 2", grid("nan.vol")), 5, "medium.base belongs to a `height` medium"),
-        ("sigma_s = 1\nfile = \"a.vol\"".into(), 3, "medium.file belongs to a `grid` medium"),
-        ("type = \"height\"\nsigma_s = 1\ndensity_scale = 2".into(), 4, "medium.density_scale belongs to a `grid`"),
+        ("type = \"grid\"\nsigma_s = 1".into(), 1, "medium (grid): a grid medium needs `file`"),
+        (format!("{}\nbase = 2", grid("nan.vol")), 5, "`base` is a key of height or noise media, not of grid media"),
+        ("sigma_s = 1\nfile = \"a.vol\"".into(), 3, "`file` is a key of grid media, not of homogeneous media"),
+        (
+            "type = \"height\"\nsigma_s = 1\ndensity_scale = 2".into(),
+            4,
+            "`density_scale` is a key of grid media, not of height media",
+        ),
         (format!("{}\ndensity_scale = -1", grid("nan.vol")), 5, "medium.density_scale must be a finite number ≥ 0"),
         (format!("{}\nscale = 0", grid("nan.vol")), 5, "medium.scale must not be zero"),
-        ("type = \"gird\"".into(), 2, "unknown variant `gird`"),
+        (
+            "type = \"gird\"".into(),
+            2,
+            "unknown type `gird`; did you mean `grid`? media are homogeneous, height, grid or noise",
+        ),
     ];
     for (medium, line, phrase) in cases {
         let e = match scene_with(dir.path(), &medium) {
@@ -130,8 +138,8 @@ fn noise_fog_is_read_and_its_bad_keys_refused() {
         (noise("min = [0, 0, 0]"), 4, "needs both min and max"),
         (noise("min = [0, 0, 0]\nmax = [1, 0, 1]"), 5, "must exceed medium.min"),
         (noise("base = 1"), 4, "medium.base needs a falloff"),
-        (noise("file = \"a.vol\""), 4, "medium.file belongs to a `grid` medium"),
-        ("sigma_s = 1\noctaves = 3".into(), 3, "medium.octaves belongs to a `noise` medium"),
+        (noise("file = \"a.vol\""), 4, "`file` is a key of grid media, not of noise media"),
+        ("sigma_s = 1\noctaves = 3".into(), 3, "`octaves` is a key of noise media, not of homogeneous media"),
     ];
     for (medium, line, phrase) in cases {
         let e = match scene_with(dir.path(), &medium) {

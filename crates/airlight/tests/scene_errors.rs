@@ -58,12 +58,16 @@ fn cases() -> Vec<(String, usize, &'static str)> {
         // 9. Position with two numbers.
         (with("[camera]\nposition = [0, 1]"), 2, "invalid length 2, expected an array of three numbers"),
         // 10. Unknown object type.
-        ("[[objects]]\ntype = \"cone\"\nmaterial = \"m\"\n".into(), 2, "unknown variant `cone`"),
+        (
+            "[[objects]]\ntype = \"cone\"\nmaterial = \"m\"\n".into(),
+            2,
+            "unknown type `cone`; objects are sphere, plane, quad, box, mesh or sdf",
+        ),
         // 11. Missing radius.
         (
             format!("{GOOD_TAIL}\n[[objects]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nmaterial = \"white\"\n"),
             16,
-            "a sphere needs `radius`",
+            "a sphere object needs `radius`",
         ),
         // 12. Negative radius.
         (
@@ -95,10 +99,10 @@ fn cases() -> Vec<(String, usize, &'static str)> {
                 "{GOOD_TAIL}\n[[objects]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\nnormal = [0, 1, 0]\nmaterial = \"white\"\n"
             ),
             20,
-            "`normal` does not belong to a sphere",
+            "`normal` is a key of plane or sdf objects, not of sphere objects",
         ),
         // 16. Unknown light type.
-        (format!("{GOOD_TAIL}\n[[lights]]\ntype = \"laser\"\n"), 17, "unknown variant `laser`"),
+        (format!("{GOOD_TAIL}\n[[lights]]\ntype = \"laser\"\n"), 17, "unknown type `laser`; lights are point, spot"),
         // 17. Spot without a direction.
         (
             format!("{GOOD_TAIL}\n[[lights]]\ntype = \"spot\"\nposition = [0, 3, 0]\nintensity = 5\n"),
@@ -138,13 +142,25 @@ fn cases() -> Vec<(String, usize, &'static str)> {
         // 22. Medium with g out of range.
         (with("[medium]\nsigma_s = 0.1\ng = 1.5"), 3, "medium.g must lie strictly between -1 and 1, got 1.5"),
         // 23. Height fields on a homogeneous medium.
-        (with("[medium]\nsigma_s = 0.1\nfalloff = 2"), 3, "base and falloff belong to a `height` medium"),
+        (
+            with("[medium]\nsigma_s = 0.1\nfalloff = 2"),
+            3,
+            "`falloff` is a key of height or noise media, not of homogeneous media",
+        ),
         // 24. Negative scattering coefficient.
         (with("[medium]\nsigma_s = [0.1, -0.2, 0.1]"), 2, "medium.sigma_s must be finite and ≥ 0"),
         // 25. Unknown material type.
-        ("[materials.m]\ntype = \"glass\"\n".into(), 2, "unknown variant `glass`"),
+        (
+            "[materials.m]\ntype = \"glass\"\n".into(),
+            2,
+            "unknown type `glass`; materials are diffuse, checker, phong or texture",
+        ),
         // 26. Checker field on a diffuse material.
-        ("[materials.m]\nalbedo2 = 0.3\n".into(), 2, "materials.m.albedo2 belongs to a checker material"),
+        (
+            "[materials.m]\nalbedo2 = 0.3\n".into(),
+            2,
+            "`albedo2` is a key of checker materials, not of diffuse materials",
+        ),
         // 27. Perspective camera with a view_height.
         (with("[camera]\nview_height = 3"), 2, "view_height is for orthographic cameras"),
         // 28. Camera looking at itself.
@@ -172,6 +188,21 @@ fn cases() -> Vec<(String, usize, &'static str)> {
             format!("{GOOD_TAIL}\n[[objects]]\ntype = \"mesh\"\nfile = \"no/such/file.obj\"\nmaterial = \"white\"\n"),
             18,
             "cannot load mesh: no file `no/such/file.obj` in the scene's folder",
+        ),
+        // 32. A spot light's key on a point light: named at the key, with
+        // the type that takes it.
+        (
+            format!(
+                "{GOOD_TAIL}\n[[lights]]\ntype = \"point\"\nposition = [0, 3, 0]\nintensity = 5\ncone_angle = 20\n"
+            ),
+            20,
+            "lights[1] (point): `cone_angle` is a key of spot lights, not of point lights",
+        ),
+        // 33. A key no type takes, a slip away from one this type takes.
+        (
+            format!("{GOOD_TAIL}\n[[lights]]\ntype = \"point\"\nposition = [0, 3, 0]\nintensity = 5\nintensty = 5\n"),
+            20,
+            "`intensty` is not a key of point lights; did you mean `intensity`?",
         ),
     ]
 }
@@ -247,7 +278,7 @@ fn analytic_settings_and_line_lights_are_checked() {
             2,
             "render.light_quadrature must be gauss or uniform, got the text \"simpson\"",
         ),
-        ("[[lights]]\ntype = \"line\"\nstart = [0, 1, 0]\nintensity = 3\n", 1, "a line needs `end`"),
+        ("[[lights]]\ntype = \"line\"\nstart = [0, 1, 0]\nintensity = 3\n", 1, "a line light needs `end`"),
         (
             "[[lights]]\ntype = \"line\"\nstart = [0, 1, 0]\nend = [0, 1, 0]\nintensity = 3\n",
             4,
@@ -256,7 +287,7 @@ fn analytic_settings_and_line_lights_are_checked() {
         (
             "[[lights]]\ntype = \"point\"\nposition = [0, 1, 0]\nend = [0, 1, 0]\nintensity = 3\n",
             4,
-            "`end` does not belong to a point",
+            "`end` is a key of line lights, not of point lights",
         ),
     ] {
         let full = format!("{text}{tail}");

@@ -106,9 +106,17 @@ fn the_isometric_scene_renders_its_fog() {
 /// text), a phrase the message must contain)
 fn bad_cases() -> Vec<(&'static str, usize, &'static str)> {
     vec![
-        ("[[objects]]\ntype = \"sdf\"\nmaterial = \"m\"\nradius = 1\n", 10, "an sdf needs `shape`"),
-        ("[[objects]]\ntype = \"sdf\"\nmaterial = \"m\"\nshape = \"blob\"\n", 13, "unknown variant `blob`"),
-        ("[[objects]]\ntype = \"sdf\"\nmaterial = \"m\"\nshape = \"sphere\"\n", 10, "a sphere needs `radius`"),
+        (
+            "[[objects]]\ntype = \"sdf\"\nmaterial = \"m\"\nradius = 1\n",
+            10,
+            "objects[0] (sdf) needs `shape`: sphere, box",
+        ),
+        (
+            "[[objects]]\ntype = \"sdf\"\nmaterial = \"m\"\nshape = \"blob\"\n",
+            13,
+            "unknown shape `blob`; did you mean `box`?",
+        ),
+        ("[[objects]]\ntype = \"sdf\"\nmaterial = \"m\"\nshape = \"sphere\"\n", 10, "a sphere node needs `radius`"),
         (
             "[[objects]]\ntype = \"sdf\"\nmaterial = \"m\"\nshape = \"sphere\"\nradius = -2\n",
             14,
@@ -117,7 +125,7 @@ fn bad_cases() -> Vec<(&'static str, usize, &'static str)> {
         (
             "[[objects]]\ntype = \"sdf\"\nmaterial = \"m\"\nshape = \"box\"\nmin = [0, 0, 0]\nmax = [1, 1, 1]\nradius = 1\n",
             16,
-            "`radius` does not belong to a box",
+            "`radius` is a key of sphere, capsule or cylinder nodes, not of box nodes",
         ),
         (
             "[[objects]]\ntype = \"sdf\"\nmaterial = \"m\"\nshape = \"union\"\nchildren = [\n  { shape = \"sphere\", radius = 1 },\n  { shape = \"torus\", major_radius = 1, minor_radius = 0 },\n]\n",
@@ -127,7 +135,7 @@ fn bad_cases() -> Vec<(&'static str, usize, &'static str)> {
         (
             "[[objects]]\ntype = \"sdf\"\nmaterial = \"m\"\nshape = \"smooth_union\"\nchildren = [{ shape = \"sphere\", radius = 1 }]\n",
             10,
-            "a smooth_union needs `blend`",
+            "a smooth_union node needs `blend`",
         ),
         ("[[objects]]\ntype = \"sdf\"\nmaterial = \"m\"\nshape = \"union\"\nchildren = []\n", 14, "must not be empty"),
         (
@@ -138,23 +146,23 @@ fn bad_cases() -> Vec<(&'static str, usize, &'static str)> {
         (
             "[[objects]]\ntype = \"sphere\"\nmaterial = \"m\"\ncenter = [0, 0, 0]\nradius = 1\nblend = 1\n",
             15,
-            "`blend` does not belong to a sphere",
+            "`blend` is a key of sdf objects, not of sphere objects",
         ),
         (
             "[[lights]]\ntype = \"box\"\nmin = [0, 0, 0]\nmax = [1, 0, 1]\nintensity = 1\n",
             13,
             "min must be less than max",
         ),
-        ("[[lights]]\ntype = \"box\"\nmin = [0, 0, 0]\nmax = [1, 1, 1]\n", 10, "a box needs `intensity`"),
+        ("[[lights]]\ntype = \"box\"\nmin = [0, 0, 0]\nmax = [1, 1, 1]\n", 10, "a box light needs `intensity`"),
         (
             "[[lights]]\ntype = \"sphere\"\nvolume = true\ncenter = [0, 0, 0]\nradius = 1\nradiance = 1\n",
             15,
-            "`radiance` does not belong",
+            "a volume sphere (volume = true) glows with `intensity` and takes no `radiance`",
         ),
         (
             "[[lights]]\ntype = \"point\"\nposition = [0, 0, 0]\nintensity = 1\nvolume = true\n",
             14,
-            "`volume` does not belong",
+            "`volume` is a key of sphere lights, not of point lights",
         ),
     ]
 }

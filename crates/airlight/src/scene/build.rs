@@ -107,14 +107,14 @@ impl Checker<'_> {
         if let Some(camera) = &desc.camera {
             builder = builder.camera(self.camera(camera)?);
         }
-        if let Some(medium) = &desc.medium {
-            builder = builder.medium(self.medium(medium)?);
+        if desc.medium.is_some() {
+            builder = builder.medium(self.medium()?);
         }
-        for (name, material) in &desc.materials {
-            builder = builder.material(name, self.material(name, material)?);
+        for name in desc.materials.keys() {
+            builder = builder.material(name, self.material(name)?);
         }
-        for (i, object) in desc.objects.iter().enumerate() {
-            let built = self.object(i, object, desc)?;
+        for i in 0..desc.objects.len() {
+            let built = self.object(i, desc)?;
             builder = built.materials.into_iter().fold(builder, |b, (name, m)| b.material(&name, m));
             builder = built.objects.into_iter().fold(builder, |b, (shape, name)| b.object(shape, &name));
             builder = built.lights.into_iter().fold(builder, SceneBuilder::light);
@@ -125,11 +125,11 @@ impl Checker<'_> {
             builder = built.objects.into_iter().fold(builder, |b, (shape, name)| b.object(shape, &name));
             builder = built.lights.into_iter().fold(builder, SceneBuilder::light);
         }
-        for (i, light) in desc.lights.iter().enumerate() {
-            let built = self.light(i, light)?;
-            builder = match self.keyframes(i, light, &built)? {
-                Some(path) => builder.moving_light(built, path),
-                None => builder.light(built),
+        for i in 0..desc.lights.len() {
+            let (light, motion) = self.light(i)?;
+            builder = match self.keyframes(i, &motion, &light)? {
+                Some(path) => builder.moving_light(light, path),
+                None => builder.light(light),
             };
         }
         builder.build()

@@ -6,119 +6,83 @@ use super::desc::*;
 use super::limits;
 use crate::light::{Attenuation, Keyframes, Light, SpotProfile};
 use glam::Vec3;
-use toml::Spanned;
+use std::ops::Range;
 
-impl Checker<'_> {
-    /// A light, checked, within [`limits::MAX_COORDINATE`] of the origin.
-    pub(super) fn light(&self, index: usize, desc: &Spanned<LightDesc>) -> Result<Light> {
-        let light = self.light_values(index, desc)?;
-        let kind = format!("{:?}", desc.get_ref().kind).to_lowercase();
+impl<'a> Checker<'a> {
+    /// The `index`th `[[lights]]` table read by its type, and the light it
+    /// makes, within [`limits::MAX_COORDINATE`] of the origin.
+    pub(super) fn light(&self, index: usize) -> Result<(Light, LightMotion)> {
+        let label = format!("lights[{index}]");
+        let read = self.read_table::<LightDesc>(self.section_element("lights", index)?, &label)?;
+        let label = format!("{label} ({})", read.name);
+        let span = read.table.span();
+        let light = self.light_values(span.clone(), &label, &read.kind)?;
         let extent = limits::light_extent(&light);
         if extent > limits::MAX_COORDINATE {
-            return Err(self.err(desc.span(), limits::too_far(&format!("lights[{index}] ({kind})"), extent)));
+            return Err(self.err(span, limits::too_far(&label, extent)));
         }
-        Ok(light)
+        Ok((light, read.shared))
     }
 
-    fn light_values(&self, index: usize, desc: &Spanned<LightDesc>) -> Result<Light> {
-        let span = desc.span();
-        let l = desc.get_ref();
-        let kind = format!("{:?}", l.kind).to_lowercase();
-        let label = format!("lights[{index}] ({kind})");
-        let fields: [(&str, bool); 22] = [
-            ("min", l.min.is_some()),
-            ("max", l.max.is_some()),
-            ("volume", l.volume.is_some()),
-            ("position", l.position.is_some()),
-            ("intensity", l.intensity.is_some()),
-            ("direction", l.direction.is_some()),
-            ("look_at", l.look_at.is_some()),
-            ("cone_angle", l.cone_angle.is_some()),
-            ("falloff_start", l.falloff_start.is_some()),
-            ("profile", l.profile.is_some()),
-            ("irradiance", l.irradiance.is_some()),
-            ("center", l.center.is_some()),
-            ("radius", l.radius.is_some()),
-            ("radiance", l.radiance.is_some()),
-            ("corner", l.corner.is_some()),
-            ("edge_u", l.edge_u.is_some()),
-            ("edge_v", l.edge_v.is_some()),
-            ("attenuation", l.attenuation.is_some()),
-            ("cutoff", l.cutoff.is_some()),
-            ("range", l.range.is_some()),
-            ("start", l.start.is_some()),
-            ("end", l.end.is_some()),
-        ];
+    fn light_values(&self, span: Range<usize>, label: &str, desc: &LightDesc) -> Result<Light> {
         let at = |name: &str| format!("{label}.{name}");
-        let point = |p: Option<Point>, name: &str| self.finite3(span.clone(), &at(name), p.unwrap().0);
-        let power = |t: Option<Triple>, name: &str| self.non_negative3(span.clone(), &at(name), t.unwrap().0);
-        let check = |required: &[&str], optional: &[&str]| {
-            self.check_fields(span.clone(), &label, &kind, &fields, required, optional)
-        };
-        const FALLOFF: [&str; 3] = ["attenuation", "cutoff", "range"];
-        let light = match l.kind {
-            LightType::Point => {
-                check(&["position", "intensity"], &[&FALLOFF[..], &["radius"]].concat())?;
-                Light::point(point(l.position, "position")?, power(l.intensity, "intensity")?)
+        let point = |p: Point, name: &str| self.finite3(span.clone(), &at(name), p.0);
+        let power = |t: Triple, name: &str| self.non_negative3(span.clone(), &at(name), t.0);
+        let (light, falloff) = match desc {
+            LightDesc::Point(l) => {
+                (Light::point(point(l.position, "position")?, power(l.intensity, "intensity")?), l.falloff())
             }
-            LightType::Spot => {
-                let optional = ["cone_angle", "falloff_start", "profile", "direction", "look_at", "radius"];
-                check(&["position", "intensity"], &[&FALLOFF[..], &optional].concat())?;
-                let position = point(l.position, "position")?;
-                let direction = match (l.direction, l.look_at) {
-                    (Some(d), None) => self.direction(span.clone(), &at("direction"), d.0)?,
-                    (None, Some(t)) => self
-                        .direction(
-                            span.clone(),
-                            &at("look_at"),
-                            self.finite3(span.clone(), &at("look_at"), t.0)? - position,
-                        )
-                        .map_err(|_| self.err(span.clone(), format!("{label}: look_at must differ from position")))?,
-                    (Some(_), Some(_)) => {
-                        return Err(self.err(span, format!("{label}: give direction or look_at, not both")));
-                    }
-                    (None, None) => {
-                        return Err(self.err(span, format!("{label}: a spot needs `direction` or `look_at`")));
-                    }
-                };
-                let cone = l.cone_angle.unwrap_or(30.0);
-                if !(cone > 0.0 && cone <= 180.0) {
-                    return Err(self.err_field(
-                        span,
-                        "cone_angle",
-                        format!("{label}.cone_angle must be in (0, 180] degrees, got {cone}"),
-                    ));
-                }
-                let start = l.falloff_start.unwrap_or(cone);
-                if !(start >= 0.0 && start <= cone) {
-                    return Err(self.err_field(
-                        span,
-                        "falloff_start",
-                        format!("{label}.falloff_start must be in [0, cone_angle = {cone}] degrees, got {start}"),
-                    ));
-                }
-                Light::Spot {
-                    position,
-                    direction,
-                    intensity: power(l.intensity, "intensity")?,
-                    cone_angle: cone.to_radians(),
-                    falloff_start: start.to_radians(),
-                    profile: l.profile.map_or(SpotProfile::Smoothstep, Into::into),
-                    attenuation: Attenuation::PHYSICAL,
-                }
-            }
-            LightType::Distant => {
-                check(&["direction", "irradiance"], &[])?;
-                let d = self.direction(span.clone(), &at("direction"), l.direction.unwrap().0)?;
+            LightDesc::Spot(l) => (self.spot(span.clone(), label, l)?, l.falloff()),
+            LightDesc::Distant(l) => {
+                let d = self.direction(span.clone(), &at("direction"), l.direction.0)?;
                 return Ok(Light::distant(d, power(l.irradiance, "irradiance")?));
             }
-            LightType::Sphere if l.volume == Some(true) => {
-                check(&["center", "radius", "intensity"], &["volume"])?;
-                let radius = self.positive(span.clone(), &at("radius"), l.radius.unwrap())?;
-                return Ok(Light::volume_sphere(point(l.center, "center")?, radius, power(l.intensity, "intensity")?));
+            LightDesc::Sphere(l) if l.volume == Some(true) => {
+                let falloff = l.falloff();
+                let other = [
+                    ("radiance", l.radiance.is_some()),
+                    ("attenuation", falloff.model.is_some()),
+                    ("cutoff", falloff.cutoff.is_some()),
+                    ("range", falloff.range.is_some()),
+                ];
+                if let Some((key, _)) = other.iter().find(|(_, given)| *given) {
+                    let why =
+                        format!("{label}: a volume sphere (volume = true) glows with `intensity` and takes no `{key}`");
+                    return Err(self.err_field(span, key, why));
+                }
+                let (Some(radius), Some(intensity)) = (l.radius, l.intensity) else {
+                    let key = if l.radius.is_none() { "radius" } else { "intensity" };
+                    return Err(self.err(span, format!("{label}: a volume sphere light needs `{key}`")));
+                };
+                let radius = self.positive(span.clone(), &at("radius"), radius)?;
+                return Ok(Light::volume_sphere(point(l.center, "center")?, radius, power(intensity, "intensity")?));
             }
-            LightType::Box => {
-                check(&["min", "max", "intensity"], &[])?;
+            LightDesc::Sphere(l) => {
+                if l.intensity.is_some() {
+                    let why =
+                        format!("{label}: a sphere light's surface emits `radiance`; `intensity` is for volume = true");
+                    return Err(self.err_field(span, "intensity", why));
+                }
+                let (Some(radius), Some(radiance)) = (l.radius, l.radiance) else {
+                    let key = if l.radius.is_none() { "radius" } else { "radiance" };
+                    return Err(self.err(span, format!("{label}: a sphere light needs `{key}`")));
+                };
+                let radius = self.positive(span.clone(), &at("radius"), radius)?;
+                (Light::sphere(point(l.center, "center")?, radius, power(radiance, "radiance")?), l.falloff())
+            }
+            LightDesc::Quad(l) => {
+                let (u, v) = (point(l.edge_u, "edge_u")?, point(l.edge_v, "edge_v")?);
+                self.edges(span.clone(), label, u, v)?;
+                return Ok(Light::quad(point(l.corner, "corner")?, u, v, power(l.radiance, "radiance")?));
+            }
+            LightDesc::Line(l) => {
+                let (a, b) = (point(l.start, "start")?, point(l.end, "end")?);
+                if a == b {
+                    return Err(self.err_field(span, "end", format!("{label}: start and end must differ")));
+                }
+                return Ok(Light::line(a, b, power(l.intensity, "intensity")?));
+            }
+            LightDesc::Box(l) => {
                 let (min, max) = (point(l.min, "min")?, point(l.max, "max")?);
                 if !min.cmplt(max).all() {
                     return Err(self.err_field(
@@ -129,34 +93,15 @@ impl Checker<'_> {
                 }
                 return Ok(Light::volume_box(min, max, power(l.intensity, "intensity")?));
             }
-            LightType::Sphere => {
-                check(&["center", "radius", "radiance"], &[&FALLOFF[..], &["volume"]].concat())?;
-                let radius = self.positive(span.clone(), &at("radius"), l.radius.unwrap())?;
-                Light::sphere(point(l.center, "center")?, radius, power(l.radiance, "radiance")?)
-            }
-            LightType::Quad => {
-                check(&["corner", "edge_u", "edge_v", "radiance"], &[])?;
-                let (u, v) = (point(l.edge_u, "edge_u")?, point(l.edge_v, "edge_v")?);
-                self.edges(span.clone(), &label, u, v)?;
-                return Ok(Light::quad(point(l.corner, "corner")?, u, v, power(l.radiance, "radiance")?));
-            }
-            LightType::Line => {
-                check(&["start", "end", "intensity"], &[])?;
-                let (a, b) = (point(l.start, "start")?, point(l.end, "end")?);
-                if a == b {
-                    return Err(self.err_field(span, "end", format!("{label}: start and end must differ")));
-                }
-                return Ok(Light::line(a, b, power(l.intensity, "intensity")?));
-            }
         };
         // The falloff of a point, spot or sphere light.
-        let radius = match l.radius {
+        let radius = match falloff.radius {
             Some(r) => self.positive(span.clone(), &at("radius"), r)?,
             None => Attenuation::PHYSICAL.radius,
         };
-        let cutoff = l.cutoff.map(|c| self.positive(span.clone(), &at("cutoff"), c)).transpose()?;
-        let range = l.range.map(|r| self.positive(span.clone(), &at("range"), r)).transpose()?;
-        let model = l.attenuation.unwrap_or_default();
+        let cutoff = falloff.cutoff.map(|c| self.positive(span.clone(), &at("cutoff"), c)).transpose()?;
+        let range = falloff.range.map(|r| self.positive(span.clone(), &at("range"), r)).transpose()?;
+        let model = falloff.model.unwrap_or_default();
         // E₀, the irradiance at the light's surface, in its brightest channel.
         let e0 = light.intensity().max_element() / (radius * radius);
         let attenuation = Attenuation::new(model, radius, e0, cutoff, range)
@@ -164,15 +109,53 @@ impl Checker<'_> {
         Ok(light.with_attenuation(attenuation))
     }
 
+    /// A spot light, aimed by `direction` or `look_at`, its cone checked.
+    fn spot(&self, span: Range<usize>, label: &str, l: &SpotLight) -> Result<Light> {
+        let at = |name: &str| format!("{label}.{name}");
+        let position = self.finite3(span.clone(), &at("position"), l.position.0)?;
+        let direction = match (l.direction, l.look_at) {
+            (Some(d), None) => self.direction(span.clone(), &at("direction"), d.0)?,
+            (None, Some(t)) => self
+                .direction(span.clone(), &at("look_at"), self.finite3(span.clone(), &at("look_at"), t.0)? - position)
+                .map_err(|_| self.err(span.clone(), format!("{label}: look_at must differ from position")))?,
+            (Some(_), Some(_)) => {
+                return Err(self.err(span, format!("{label}: give direction or look_at, not both")));
+            }
+            (None, None) => {
+                return Err(self.err(span, format!("{label}: a spot needs `direction` or `look_at`")));
+            }
+        };
+        let cone = l.cone_angle.unwrap_or(30.0);
+        if !(cone > 0.0 && cone <= 180.0) {
+            return Err(self.err_field(
+                span,
+                "cone_angle",
+                format!("{label}.cone_angle must be in (0, 180] degrees, got {cone}"),
+            ));
+        }
+        let start = l.falloff_start.unwrap_or(cone);
+        if !(start >= 0.0 && start <= cone) {
+            return Err(self.err_field(
+                span,
+                "falloff_start",
+                format!("{label}.falloff_start must be in [0, cone_angle = {cone}] degrees, got {start}"),
+            ));
+        }
+        Ok(Light::Spot {
+            position,
+            direction,
+            intensity: self.non_negative3(span, &at("intensity"), l.intensity.0)?,
+            cone_angle: cone.to_radians(),
+            falloff_start: start.to_radians(),
+            profile: l.profile.map_or(SpotProfile::Smoothstep, Into::into),
+            attenuation: Attenuation::PHYSICAL,
+        })
+    }
+
     /// A light's `keyframes`: times in [0, 1], strictly increasing, finite
     /// positions; not on a distant light.
-    pub(super) fn keyframes(
-        &self,
-        index: usize,
-        desc: &Spanned<LightDesc>,
-        light: &Light,
-    ) -> Result<Option<Keyframes>> {
-        let Some(keys) = &desc.get_ref().keyframes else {
+    pub(super) fn keyframes(&self, index: usize, motion: &LightMotion, light: &Light) -> Result<Option<Keyframes>> {
+        let Some(keys) = &motion.keyframes else {
             return Ok(None);
         };
         let label = format!("lights[{index}].keyframes");

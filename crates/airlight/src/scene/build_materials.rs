@@ -4,14 +4,13 @@
 
 use super::assets::AssetPath;
 use super::build::{Checker, Result, parse};
-use super::desc::{self, MaterialDesc, MaterialType, Triple};
+use super::desc::{self, MaterialDesc, Triple};
 use super::{SceneDesc, SceneError};
 use crate::Rgb;
 use crate::material::Material;
 use crate::medium::Medium;
 use glam::Vec3;
 use std::cell::{Cell, RefCell};
-use toml::Spanned;
 
 /// A medium from the keys of a scene file's `[medium]` table written as
 /// one line, `key = value` pairs separated by commas (`sigma_s = 0.05,
@@ -24,78 +23,58 @@ pub fn medium_from_options(options: &str) -> Result<Medium, String> {
     let text = format!("medium = {{ {options} }}");
     let strip = |e: SceneError| e.message;
     let desc: SceneDesc = parse(&text).map_err(strip)?;
-    let Some(medium) = &desc.medium else { return Err("no medium".into()) };
+    if desc.medium.is_none() {
+        return Err("no medium".into());
+    }
     let assets = AssetPath::CommandLine;
+    let document = toml::de::DeTable::parse(&text).map_err(|e| e.message().to_string())?.into_inner();
     let checker = Checker {
         text: &text,
         assets: &assets,
-        document: Default::default(),
+        document,
         files: RefCell::default(),
         mesh_bytes: Cell::new(0),
         notes: RefCell::default(),
         textures: RefCell::default(),
     };
-    checker.medium(medium).map_err(strip)
+    checker.medium().map_err(strip)
 }
 
 impl Checker<'_> {
-    pub(super) fn material(&self, name: &str, desc: &Spanned<MaterialDesc>) -> Result<Material> {
-        let span = desc.span();
-        let m = desc.get_ref();
-        let what = |field: &str| format!("materials.{name}.{field}");
+    /// The material `[materials.NAME]` describes, read by its type.
+    pub(super) fn material(&self, name: &str) -> Result<Material> {
+        let label = format!("materials.{name}");
+        let read = self.read_table::<MaterialDesc>(self.section_field("materials", name)?, &label)?;
+        let span = read.table.span();
+        let what = |field: &str| format!("{label}.{field}");
         let albedo = |t: Option<Triple>, field: &str, default: f32| -> Result<Rgb> {
             self.non_negative3(span.clone(), &what(field), t.map_or(Vec3::splat(default), |t| t.0))
         };
-        let misplaced = |present: bool, field: &str, owner: &str| -> Result<()> {
-            if present {
-                Err(self.err_field(span.clone(), field, format!("{} belongs to a {owner} material", what(field))))
-            } else {
-                Ok(())
+        Ok(match &read.kind {
+            MaterialDesc::Diffuse(m) => Material::diffuse(albedo(m.albedo, "albedo", 0.8)?),
+            MaterialDesc::Checker(m) => {
+                let (a, a2) = (albedo(m.albedo, "albedo", 0.8)?, albedo(m.albedo2, "albedo2", 0.2)?);
+                Material::checker(a, a2, self.positive(span, &what("scale"), m.scale.unwrap_or(1.0))?)
             }
-        };
-        if m.kind != MaterialType::Checker {
-            misplaced(m.albedo2.is_some(), "albedo2", "checker")?;
-            misplaced(m.scale.is_some(), "scale", "checker")?;
-        }
-        if m.kind != MaterialType::Phong {
-            misplaced(m.specular.is_some(), "specular", "phong")?;
-            misplaced(m.exponent.is_some(), "exponent", "phong")?;
-        }
-        if m.kind != MaterialType::Texture {
-            misplaced(m.file.is_some(), "file", "texture")?;
-            misplaced(m.wrap.is_some(), "wrap", "texture")?;
-        }
-        if m.kind == MaterialType::Texture {
-            let Some(file) = &m.file else {
-                return Err(self.err(span, format!("materials.{name}: a texture material needs a `file` (an image)")));
-            };
-            let factor = albedo(m.albedo, "albedo", 1.0)?;
-            let texture = self.texture_file(file.get_ref()).map_err(|why| {
-                self.err(file.span(), format!("materials.{name}.file: cannot load the texture: {why}"))
-            })?;
-            let texture = match &m.wrap {
-                Some(w) => {
-                    let wrap = desc::parse_name(w, &what("wrap")).map_err(|e| self.err(e.span, e.message))?;
-                    std::sync::Arc::new((*texture).clone().with_wrap(wrap, wrap))
-                }
-                None => texture,
-            };
-            return Ok(Material::textured(factor, texture));
-        }
-        let a = albedo(m.albedo, "albedo", 0.8)?;
-        Ok(match m.kind {
-            MaterialType::Diffuse => Material::diffuse(a),
-            MaterialType::Checker => {
-                let a2 = albedo(m.albedo2, "albedo2", 0.2)?;
-                let scale = self.positive(span, &what("scale"), m.scale.unwrap_or(1.0))?;
-                Material::checker(a, a2, scale)
-            }
-            MaterialType::Phong => {
+            MaterialDesc::Phong(m) => {
                 let specular = albedo(m.specular, "specular", 0.04)?;
-                let exponent = self.non_negative(span, &what("exponent"), m.exponent.unwrap_or(32.0))?;
-                Material::phong(a, specular, exponent)
+                let exponent = self.non_negative(span.clone(), &what("exponent"), m.exponent.unwrap_or(32.0))?;
+                Material::phong(albedo(m.albedo, "albedo", 0.8)?, specular, exponent)
             }
-            MaterialType::Texture => unreachable!("returned above"),
+            MaterialDesc::Texture(m) => {
+                let factor = albedo(m.albedo, "albedo", 1.0)?;
+                let texture = self
+                    .texture_file(m.file.get_ref())
+                    .map_err(|why| self.err(m.file.span(), format!("{label}.file: cannot load the texture: {why}")))?;
+                let texture = match &m.wrap {
+                    Some(w) => {
+                        let wrap = desc::parse_name(w, &what("wrap")).map_err(|e| self.err(e.span, e.message))?;
+                        std::sync::Arc::new((*texture).clone().with_wrap(wrap, wrap))
+                    }
+                    None => texture,
+                };
+                Material::textured(factor, texture)
+            }
         })
     }
 }

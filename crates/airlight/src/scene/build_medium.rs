@@ -4,92 +4,41 @@
 //! what is wrong with it.
 
 use super::build::{Checker, Result};
-use super::desc::{MediumDesc, MediumType};
+use super::desc::{GridMedium, HomogeneousMedium, MediumDesc, NoiseMedium};
 use super::limits;
 use crate::medium::noise::MAX_OCTAVES;
 use crate::medium::{DensityGrid, Medium, NoiseFog, vol};
 use glam::Vec3;
-use toml::Spanned;
+use std::ops::Range;
 
 impl Checker<'_> {
-    pub(super) fn medium(&self, desc: &Spanned<MediumDesc>) -> Result<Medium> {
-        let span = desc.span();
-        let m = desc.get_ref();
-        let sigma_a = self.non_negative3(span.clone(), "medium.sigma_a", m.sigma_a.map_or(Vec3::ZERO, |t| t.0))?;
-        let sigma_s = self.non_negative3(span.clone(), "medium.sigma_s", m.sigma_s.map_or(Vec3::ZERO, |t| t.0))?;
-        let g = m.g.unwrap_or(0.0);
+    /// The medium `[medium]` describes, read by its type.
+    pub(super) fn medium(&self) -> Result<Medium> {
+        let read = self.read_table::<MediumDesc>(self.section("medium")?, "medium")?;
+        let span = read.table.span();
+        let c = &read.shared;
+        let sigma_a = self.non_negative3(span.clone(), "medium.sigma_a", c.sigma_a.map_or(Vec3::ZERO, |t| t.0))?;
+        let sigma_s = self.non_negative3(span.clone(), "medium.sigma_s", c.sigma_s.map_or(Vec3::ZERO, |t| t.0))?;
+        let g = c.g.unwrap_or(0.0);
         if !(g > -1.0 && g < 1.0) {
             return Err(self.err_field(span, "g", format!("medium.g must lie strictly between -1 and 1, got {g}")));
         }
-        // Keys that belong to other types of medium, reported at the first.
-        let misplaced = |owner: &str, keys: &[(&str, bool)]| -> Result<()> {
-            match keys.iter().find(|(_, present)| *present) {
-                Some((key, _)) => Err(self.err_field(
-                    span.clone(),
-                    key,
-                    format!("medium.{key} belongs to a `{owner}` medium, not this one"),
-                )),
-                None => Ok(()),
-            }
-        };
-        let grid_keys = [
-            ("file", m.file.is_some()),
-            ("density_scale", m.density_scale.is_some()),
-            ("translate", m.translate.is_some()),
-            ("rotate", m.rotate.is_some()),
-            ("scale", m.scale.is_some()),
-        ];
-        let height_keys = [("base", m.base.is_some()), ("falloff", m.falloff.is_some())];
-        let noise_keys = [
-            ("octaves", m.octaves.is_some()),
-            ("gain", m.gain.is_some()),
-            ("offset", m.offset.is_some()),
-            ("seed", m.seed.is_some()),
-            ("min", m.min.is_some()),
-            ("max", m.max.is_some()),
-        ];
-        // `scale` belongs to both grid and noise.
-        let grid_only = &grid_keys[..4];
-        match m.kind {
-            MediumType::Homogeneous => {
-                if m.base.is_some() || m.falloff.is_some() {
-                    return Err(self.err_field(
-                        span,
-                        if m.base.is_some() { "base" } else { "falloff" },
-                        "base and falloff belong to a `height` medium, not a homogeneous one",
-                    ));
-                }
-                misplaced("grid", &grid_keys)?;
-                misplaced("noise", &noise_keys)?;
-                Ok(Medium::homogeneous(sigma_a, sigma_s, g))
-            }
-            MediumType::Height => {
-                misplaced("grid", &grid_keys)?;
-                misplaced("noise", &noise_keys)?;
+        match &read.kind {
+            MediumDesc::Homogeneous(HomogeneousMedium {}) => Ok(Medium::homogeneous(sigma_a, sigma_s, g)),
+            MediumDesc::Height(m) => {
                 let base = self.finite(span.clone(), "medium.base", m.base.unwrap_or(0.0))?;
                 let falloff = self.non_negative(span, "medium.falloff", m.falloff.unwrap_or(0.5))?;
                 Ok(Medium::height(sigma_a, sigma_s, g, base, falloff))
             }
-            MediumType::Grid => {
-                misplaced("height", &height_keys)?;
-                misplaced("noise", &noise_keys)?;
-                Ok(Medium::grid(sigma_a, sigma_s, g, self.density_grid(desc)?))
-            }
-            MediumType::Noise => {
-                misplaced("grid", grid_only)?;
-                Ok(Medium::noise(sigma_a, sigma_s, g, self.noise_fog(desc)?))
-            }
+            MediumDesc::Grid(m) => Ok(Medium::grid(sigma_a, sigma_s, g, self.density_grid(span, m)?)),
+            MediumDesc::Noise(m) => Ok(Medium::noise(sigma_a, sigma_s, g, self.noise_fog(span, m)?)),
         }
     }
 
     /// The grid of a `type = "grid"` medium: its file read and checked,
     /// scaled by `density_scale` and placed by `translate`, `rotate`, `scale`.
-    fn density_grid(&self, desc: &Spanned<MediumDesc>) -> Result<DensityGrid> {
-        let span = desc.span();
-        let m = desc.get_ref();
-        let Some(file) = &m.file else {
-            return Err(self.err(span, "a `grid` medium needs `file`, a Mitsuba .vol density grid"));
-        };
+    fn density_grid(&self, span: Range<usize>, m: &GridMedium) -> Result<DensityGrid> {
+        let file = &m.file;
         let density_scale = self.non_negative(span.clone(), "medium.density_scale", m.density_scale.unwrap_or(1.0))?;
         let transform = self.transform_parts(span.clone(), "medium", m.translate, m.rotate, m.scale)?;
         let name = file.get_ref();
@@ -121,9 +70,7 @@ impl Checker<'_> {
     }
 
     /// The fog of a `type = "noise"` medium, its parameters checked.
-    fn noise_fog(&self, desc: &Spanned<MediumDesc>) -> Result<NoiseFog> {
-        let span = desc.span();
-        let m = desc.get_ref();
+    fn noise_fog(&self, span: Range<usize>, m: &NoiseMedium) -> Result<NoiseFog> {
         let scale = m.scale.map_or(Vec3::ONE, |s| s.0);
         if !(scale.is_finite() && scale.min_element() > 0.0) {
             return Err(self.err_field(span, "scale", format!("medium.scale must be finite and > 0, got {scale}")));

@@ -25,69 +25,38 @@ pub(super) struct Built {
 }
 
 impl Checker<'_> {
-    pub(super) fn object(&self, index: usize, desc: &Spanned<ObjectDesc>, scene: &SceneDesc) -> Result<Built> {
-        let span = desc.span();
-        let o = desc.get_ref();
-        let kind = format!("{:?}", o.kind).to_lowercase();
-        let label = format!("objects[{index}] ({kind})");
-        let fields: [(&str, bool); 18] = [
-            ("shape", o.shape.is_some()),
-            ("children", o.children.is_some()),
-            ("blend", o.blend.is_some()),
-            ("a", o.a.is_some()),
-            ("b", o.b.is_some()),
-            ("major_radius", o.major_radius.is_some()),
-            ("minor_radius", o.minor_radius.is_some()),
-            ("rounding", o.rounding.is_some()),
-            ("center", o.center.is_some()),
-            ("radius", o.radius.is_some()),
-            ("point", o.point.is_some()),
-            ("normal", o.normal.is_some()),
-            ("corner", o.corner.is_some()),
-            ("edge_u", o.edge_u.is_some()),
-            ("edge_v", o.edge_v.is_some()),
-            ("min", o.min.is_some()),
-            ("max", o.max.is_some()),
-            ("file", o.file.is_some()),
-        ];
-        let takes: &[&str] = match o.kind {
-            ObjectType::Sphere => &["center", "radius"],
-            ObjectType::Plane => &["point", "normal"],
-            ObjectType::Quad => &["corner", "edge_u", "edge_v"],
-            ObjectType::Box => &["min", "max"],
-            ObjectType::Mesh => &["file"],
-            // The node's own shape decides (sdf.rs); other types' fields are not for it.
-            ObjectType::Sdf => {
-                let sdf_fields = fields.iter().filter(|(n, _)| !matches!(*n, "corner" | "edge_u" | "edge_v" | "file"));
-                let names: Vec<&str> = sdf_fields.map(|(n, _)| *n).collect();
-                self.check_fields(span.clone(), &label, &kind, &fields, &[], &names)?;
-                &[]
-            }
-        };
-        if o.kind != ObjectType::Sdf {
-            self.check_fields(span.clone(), &label, &kind, &fields, takes, &[])?;
+    /// The `index`th `[[objects]]` table read by its type, and what it
+    /// builds.
+    pub(super) fn object(&self, index: usize, scene: &SceneDesc) -> Result<Built> {
+        let label = format!("objects[{index}]");
+        let read = self.read_table::<ObjectDesc>(self.section_element("objects", index)?, &label)?;
+        let label = format!("{label} ({})", read.name);
+        let span = read.table.span();
+        let o = &read.shared;
+        let transform = self.transform_parts(span.clone(), &label, o.translate, o.rotate, o.scale)?;
+        if let ObjectDesc::Mesh(mesh) = &read.kind
+            && o.material.is_none()
+            && o.emission.is_none()
+        {
+            return self.mesh_with_materials(span, &label, &mesh.file, transform);
         }
-        if o.kind == ObjectType::Mesh && o.material.is_none() && o.emission.is_none() {
-            let transform = self.transform(span.clone(), &label, o)?;
-            return self.mesh_with_materials(span, &label, o.file.as_ref().unwrap(), transform);
-        }
-        let get = |p: Option<Point>, name: &str| self.finite3(span.clone(), &format!("{label}.{name}"), p.unwrap().0);
-        let shape = match o.kind {
-            ObjectType::Sphere => {
-                let radius = self.positive(span.clone(), &format!("{label}.radius"), o.radius.unwrap())?;
-                Shape::sphere(get(o.center, "center")?, radius)
+        let get = |p: Point, name: &str| self.finite3(span.clone(), &format!("{label}.{name}"), p.0);
+        let shape = match &read.kind {
+            ObjectDesc::Sphere(s) => {
+                let radius = self.positive(span.clone(), &format!("{label}.radius"), s.radius)?;
+                Shape::sphere(get(s.center, "center")?, radius)
             }
-            ObjectType::Plane => {
-                let normal = self.direction(span.clone(), &format!("{label}.normal"), o.normal.unwrap().0)?;
-                Shape::plane(get(o.point, "point")?, normal)
+            ObjectDesc::Plane(p) => {
+                let normal = self.direction(span.clone(), &format!("{label}.normal"), p.normal.0)?;
+                Shape::plane(get(p.point, "point")?, normal)
             }
-            ObjectType::Quad => {
-                let (u, v) = (get(o.edge_u, "edge_u")?, get(o.edge_v, "edge_v")?);
+            ObjectDesc::Quad(q) => {
+                let (u, v) = (get(q.edge_u, "edge_u")?, get(q.edge_v, "edge_v")?);
                 self.edges(span.clone(), &label, u, v)?;
-                Shape::quad(get(o.corner, "corner")?, u, v)
+                Shape::quad(get(q.corner, "corner")?, u, v)
             }
-            ObjectType::Box => {
-                let (min, max) = (get(o.min, "min")?, get(o.max, "max")?);
+            ObjectDesc::Box(b) => {
+                let (min, max) = (get(b.min, "min")?, get(b.max, "max")?);
                 if !min.cmplt(max).all() {
                     return Err(self.err_field(
                         span,
@@ -97,10 +66,9 @@ impl Checker<'_> {
                 }
                 Shape::cuboid(min, max)
             }
-            ObjectType::Mesh => self.mesh(&label, o.file.as_ref().unwrap())?,
-            ObjectType::Sdf => Shape::Sdf(self.sdf_object(span.clone(), &label, o)?),
+            ObjectDesc::Mesh(mesh) => self.mesh(&label, &mesh.file)?,
+            ObjectDesc::Sdf(SdfObject) => Shape::Sdf(self.sdf_object(&label, &read.table)?),
         };
-        let transform = self.transform(span.clone(), &label, o)?;
         if let Some(emission) = o.emission {
             let radiance = self.non_negative3(span.clone(), &format!("{label}.emission"), emission.0)?;
             if let Some(material) = &o.material {
@@ -256,40 +224,6 @@ impl Checker<'_> {
             _ => {}
         }
         Ok(shape)
-    }
-
-    /// Checks that an object or light has every field its type needs and
-    /// none that belongs to another type.
-    pub(super) fn check_fields(
-        &self,
-        span: Range<usize>,
-        label: &str,
-        kind: &str,
-        fields: &[(&str, bool)],
-        required: &[&str],
-        optional: &[&str],
-    ) -> Result<()> {
-        for (name, present) in fields {
-            if *present && !required.contains(name) && !optional.contains(name) {
-                let takes = [required, optional].concat();
-                return Err(self.err_field(
-                    span,
-                    name,
-                    format!("{label}: `{name}` does not belong to a {kind}, which takes {}", list(&takes)),
-                ));
-            }
-        }
-        for name in required {
-            if !fields.iter().any(|(n, present)| n == name && *present) {
-                return Err(self.err(span, format!("{label}: a {kind} needs `{name}`")));
-            }
-        }
-        Ok(())
-    }
-
-    /// T·Rz·Ry·Rx·S: scale, then rotate about X, Y, Z (degrees), then translate.
-    fn transform(&self, span: Range<usize>, label: &str, o: &ObjectDesc) -> Result<Affine3A> {
-        self.transform_parts(span, label, o.translate, o.rotate, o.scale)
     }
 
     /// The transform of `translate`, `rotate` (degrees) and `scale`, each optional.

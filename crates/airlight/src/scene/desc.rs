@@ -1,7 +1,10 @@
-//! The scene file as written: plain serde structs for the format that
-//! docs/scene-format.md describes. Unknown keys are errors. `build.rs` checks the values
-//! and turns them into a [`Scene`](super::Scene).
+//! The scene file as written: serde structs for the format that
+//! docs/scene-format.md describes, one per type of light, object, material,
+//! medium and SDF node (their fields are the type's keys; see
+//! [`super::tables`]). Unknown keys are errors. `build.rs` checks the
+//! values and turns them into a [`Scene`](super::Scene).
 
+use super::tables::{NoShared, TableAt, Tagged, tagged};
 use crate::light::{AttenuationModel, SpotProfile};
 use crate::options::OptionValue;
 use glam::Vec3;
@@ -18,13 +21,15 @@ pub struct SceneDesc {
     #[serde(default)]
     pub render: RenderDesc,
     pub camera: Option<Spanned<CameraDesc>>,
-    pub medium: Option<Spanned<MediumDesc>>,
+    // The tables below are read by their type's struct when the scene is
+    // built ([`super::tables`]); here only their places are kept.
+    pub medium: Option<Spanned<TableAt>>,
     #[serde(default)]
-    pub materials: BTreeMap<String, Spanned<MaterialDesc>>,
+    pub materials: BTreeMap<String, Spanned<TableAt>>,
     #[serde(default)]
-    pub objects: Vec<Spanned<ObjectDesc>>,
+    pub objects: Vec<Spanned<TableAt>>,
     #[serde(default)]
-    pub lights: Vec<Spanned<LightDesc>>,
+    pub lights: Vec<Spanned<TableAt>>,
     #[serde(default)]
     pub include: Vec<Spanned<IncludeDesc>>,
 }
@@ -88,214 +93,420 @@ fn perspective() -> CameraType {
     CameraType::Perspective
 }
 
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum MediumType {
-    Homogeneous,
-    Height,
-    Grid,
-    Noise,
+tagged! {
+    /// The `[medium]` table, by its `type`.
+    pub(crate) enum MediumDesc {
+        tag: "type", family: ("medium", "media"), default: Some("homogeneous"), shared: MediumCoefficients,
+        Homogeneous(HomogeneousMedium) = "homogeneous",
+        Height(HeightMedium) = "height",
+        Grid(GridMedium) = "grid",
+        Noise(NoiseMedium) = "noise",
+    }
+}
+
+/// What every medium has: its coefficients (per unit density) and phase.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct MediumCoefficients {
+    pub sigma_a: Option<Triple>,
+    pub sigma_s: Option<Triple>,
+    pub g: Option<f32>,
 }
 
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct MediumDesc {
-    #[serde(rename = "type", default = "homogeneous")]
-    pub kind: MediumType,
-    pub sigma_a: Option<Triple>,
-    pub sigma_s: Option<Triple>,
-    pub g: Option<f32>,
+pub(crate) struct HomogeneousMedium {}
+
+/// Density exp(−falloff·(y − base)).
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct HeightMedium {
     pub base: Option<f32>,
     pub falloff: Option<f32>,
-    /// Grid: the `.vol` file, its densities' multiplier and its placement.
-    pub file: Option<Spanned<String>>,
+}
+
+/// A density grid from a Mitsuba `.vol` file, its densities' multiplier
+/// and its placement.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct GridMedium {
+    pub file: Spanned<String>,
     pub density_scale: Option<f32>,
     pub translate: Option<Point>,
     pub rotate: Option<Point>,
-    /// Grid: the transform's scale; noise: the largest features' size.
     pub scale: Option<Triple>,
-    /// Noise: its octaves, gain, offset, seed and box.
+}
+
+/// Procedural fog: its features' size, octaves, gain, offset, seed, box
+/// and height falloff.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct NoiseMedium {
+    pub scale: Option<Triple>,
     pub octaves: Option<Spanned<i64>>,
     pub gain: Option<f32>,
     pub offset: Option<f32>,
     pub seed: Option<Spanned<i64>>,
     pub min: Option<Point>,
     pub max: Option<Point>,
+    pub base: Option<f32>,
+    pub falloff: Option<f32>,
 }
 
-fn homogeneous() -> MediumType {
-    MediumType::Homogeneous
-}
-
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum MaterialType {
-    Diffuse,
-    Checker,
-    Phong,
-    Texture,
+tagged! {
+    /// One `[materials.NAME]` table, by its `type`.
+    pub(crate) enum MaterialDesc {
+        tag: "type", family: ("material", "materials"), default: Some("diffuse"), shared: NoShared,
+        Diffuse(DiffuseMaterial) = "diffuse",
+        Checker(CheckerMaterial) = "checker",
+        Phong(PhongMaterial) = "phong",
+        Texture(TextureMaterial) = "texture",
+    }
 }
 
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct MaterialDesc {
-    #[serde(rename = "type", default = "diffuse")]
-    pub kind: MaterialType,
+pub(crate) struct DiffuseMaterial {
+    pub albedo: Option<Triple>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct CheckerMaterial {
     pub albedo: Option<Triple>,
     pub albedo2: Option<Triple>,
     pub scale: Option<f32>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct PhongMaterial {
+    pub albedo: Option<Triple>,
     pub specular: Option<Triple>,
     pub exponent: Option<f32>,
-    /// texture: the image file (PNG or JPEG), under the asset rules.
-    pub file: Option<Spanned<String>>,
-    /// texture: `repeat`, `clamp` or `mirror`.
+}
+
+/// An image (PNG or JPEG, under the asset rules) times `albedo`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct TextureMaterial {
+    pub albedo: Option<Triple>,
+    pub file: Spanned<String>,
+    /// `repeat`, `clamp` or `mirror`.
     pub wrap: Option<Spanned<String>>,
 }
 
-fn diffuse() -> MaterialType {
-    MaterialType::Diffuse
+tagged! {
+    /// One `[[objects]]` table, by its `type`.
+    pub(crate) enum ObjectDesc {
+        tag: "type", family: ("object", "objects"), default: None, shared: Placement,
+        Sphere(SphereObject) = "sphere",
+        Plane(PlaneObject) = "plane",
+        Quad(QuadObject) = "quad",
+        Box(BoxObject) = "box",
+        Mesh(MeshObject) = "mesh",
+        /// A signed distance field: the table is its root node, whose
+        /// `shape` picks the node's keys ([`SdfNodeDesc`]).
+        Sdf(SdfObject) = "sdf",
+    }
 }
 
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum ObjectType {
-    Sphere,
-    Plane,
-    Quad,
-    Box,
-    Mesh,
-    Sdf,
-}
-
-/// One `[[objects]]` table. Fields are optional here; which ones a type
-/// needs (and allows) is checked when the scene is built.
+/// What every object has: its material (or the radiance it emits) and its
+/// place.
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct ObjectDesc {
-    #[serde(rename = "type")]
-    pub kind: ObjectType,
+pub(crate) struct Placement {
     pub material: Option<Spanned<String>>,
-    pub center: Option<Point>,
-    pub radius: Option<f32>,
-    pub point: Option<Point>,
-    pub normal: Option<Point>,
-    pub corner: Option<Point>,
-    pub edge_u: Option<Point>,
-    pub edge_v: Option<Point>,
-    pub min: Option<Point>,
-    pub max: Option<Point>,
-    pub file: Option<Spanned<String>>,
     /// Radiance the surface emits (sphere, quad and mesh objects): the
     /// object becomes area lights, one per triangle for a mesh.
     pub emission: Option<Triple>,
     pub translate: Option<Point>,
     pub rotate: Option<Point>,
     pub scale: Option<Triple>,
-    // Signed distance fields (`type = "sdf"`): the root node's fields, as in
-    // [`SdfNodeDesc`].
-    pub shape: Option<SdfShape>,
-    pub children: Option<Vec<Spanned<SdfNodeDesc>>>,
-    pub blend: Option<f32>,
-    pub a: Option<Point>,
-    pub b: Option<Point>,
-    pub major_radius: Option<f32>,
-    pub minor_radius: Option<f32>,
-    pub rounding: Option<f32>,
 }
 
-/// The kinds of node of a signed distance field.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum SdfShape {
-    Sphere,
-    Box,
-    RoundBox,
-    Torus,
-    Capsule,
-    Cylinder,
-    Plane,
-    Union,
-    Intersection,
-    Subtraction,
-    SmoothUnion,
-}
-
-/// One node of a signed distance field: a primitive with its parameters or
-/// a combination with `children`, each placed by its own translate, rotate,
-/// scale. Which fields a shape takes is checked when the scene is built.
-#[derive(Debug, Clone, Deserialize)]
+#[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct SdfNodeDesc {
-    pub shape: SdfShape,
-    pub center: Option<Point>,
-    pub radius: Option<f32>,
-    pub min: Option<Point>,
-    pub max: Option<Point>,
-    pub point: Option<Point>,
-    pub normal: Option<Point>,
-    pub a: Option<Point>,
-    pub b: Option<Point>,
-    pub major_radius: Option<f32>,
-    pub minor_radius: Option<f32>,
-    pub rounding: Option<f32>,
-    pub blend: Option<f32>,
-    pub children: Option<Vec<Spanned<SdfNodeDesc>>>,
+pub(crate) struct SphereObject {
+    pub center: Point,
+    pub radius: f32,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct PlaneObject {
+    pub point: Point,
+    pub normal: Point,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct QuadObject {
+    pub corner: Point,
+    pub edge_u: Point,
+    pub edge_v: Point,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct BoxObject {
+    pub min: Point,
+    pub max: Point,
+}
+
+/// An OBJ file, under the asset rules.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct MeshObject {
+    pub file: Spanned<String>,
+}
+
+/// The root node of an SDF object: the table's keys other than the
+/// object's, read as the SDF node their `shape` names ([`SdfNodeDesc`])
+/// when the object is built. Its keys are every node's.
+#[derive(Debug)]
+pub(crate) struct SdfObject;
+
+impl<'de> Deserialize<'de> for SdfObject {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct Skip;
+        impl<'de> Visitor<'de> for Skip {
+            type Value = SdfObject;
+            fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+                f.write_str("the keys of an SDF node")
+            }
+            fn visit_map<A: de::MapAccess<'de>>(self, mut map: A) -> Result<SdfObject, A::Error> {
+                while map.next_entry::<de::IgnoredAny, de::IgnoredAny>()?.is_some() {}
+                Ok(SdfObject)
+            }
+        }
+        d.deserialize_struct("SdfObject", sdf_node_keys(), Skip)
+    }
+}
+
+/// `shape` and the keys of every SDF node's shape.
+fn sdf_node_keys() -> &'static [&'static str] {
+    static KEYS: std::sync::OnceLock<Vec<&'static str>> = std::sync::OnceLock::new();
+    KEYS.get_or_init(|| {
+        let mut keys = vec![<SdfNodeDesc as Tagged>::TAG];
+        for shape in <SdfNodeDesc as Tagged>::TYPES {
+            keys.extend(SdfNodeDesc::keys(shape).iter().filter(|k| !keys.contains(k)).collect::<Vec<_>>());
+        }
+        keys
+    })
+}
+
+tagged! {
+    /// One node of a signed distance field, by its `shape`: a primitive
+    /// with its parameters, or a combination of `children`.
+    pub(crate) enum SdfNodeDesc {
+        tag: "shape", family: ("node", "nodes"), default: None, shared: NodePlacement,
+        Sphere(SdfSphere) = "sphere",
+        Box(SdfBox) = "box",
+        RoundBox(SdfRoundBox) = "round_box",
+        Torus(SdfTorus) = "torus",
+        Capsule(SdfSegment) = "capsule",
+        Cylinder(SdfSegment) = "cylinder",
+        Plane(SdfPlane) = "plane",
+        Union(SdfCombination) = "union",
+        Intersection(SdfCombination) = "intersection",
+        Subtraction(SdfCombination) = "subtraction",
+        SmoothUnion(SdfSmoothUnion) = "smooth_union",
+    }
+}
+
+/// Where a node sits in its parent (a root node is placed by its object's
+/// keys instead).
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct NodePlacement {
     pub translate: Option<Point>,
     pub rotate: Option<Point>,
     pub scale: Option<Triple>,
 }
 
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum LightType {
-    Point,
-    Spot,
-    Distant,
-    Sphere,
-    Quad,
-    Line,
-    /// A volume light filling a box.
-    Box,
-}
-
-/// One `[[lights]]` table; as for objects, the fields a type needs are
-/// checked when the scene is built.
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct LightDesc {
-    #[serde(rename = "type")]
-    pub kind: LightType,
-    pub position: Option<Point>,
-    pub intensity: Option<Triple>,
-    pub direction: Option<Point>,
-    pub look_at: Option<Point>,
-    pub cone_angle: Option<f32>,
-    pub falloff_start: Option<f32>,
-    pub profile: Option<SpotProfileDesc>,
-    pub irradiance: Option<Triple>,
+pub(crate) struct SdfSphere {
     pub center: Option<Point>,
-    pub radius: Option<f32>,
-    pub radiance: Option<Triple>,
-    pub corner: Option<Point>,
-    pub edge_u: Option<Point>,
-    pub edge_v: Option<Point>,
-    pub start: Option<Point>,
-    pub end: Option<Point>,
-    /// Point, spot and sphere lights: how light falls off with distance.
-    pub attenuation: Option<AttenuationModel>,
-    /// Irradiance below which a finite-range falloff drops the light.
-    pub cutoff: Option<f32>,
-    /// d_max: how far from its surface a finite-range falloff reaches.
-    pub range: Option<f32>,
-    /// Box light: its corners.
-    pub min: Option<Point>,
-    pub max: Option<Point>,
-    /// Sphere light: a glowing ball (volume light of `intensity`) instead of
-    /// a surface of `radiance`.
-    pub volume: Option<bool>,
-    /// The path the light moves along in animations; see
-    /// [`crate::light::Keyframes`].
+    pub radius: f32,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct SdfBox {
+    pub min: Point,
+    pub max: Point,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct SdfRoundBox {
+    pub min: Point,
+    pub max: Point,
+    pub rounding: f32,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct SdfTorus {
+    pub center: Option<Point>,
+    pub major_radius: f32,
+    pub minor_radius: f32,
+}
+
+/// A capsule or a cylinder: the segment from `a` to `b`, and the radius.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct SdfSegment {
+    pub a: Point,
+    pub b: Point,
+    pub radius: f32,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct SdfPlane {
+    pub point: Option<Point>,
+    pub normal: Point,
+}
+
+/// A union, intersection or subtraction: its children, each read as a node
+/// when built.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct SdfCombination {
+    pub children: Vec<Spanned<TableAt>>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct SdfSmoothUnion {
+    pub children: Vec<Spanned<TableAt>>,
+    pub blend: f32,
+}
+
+tagged! {
+    /// One `[[lights]]` table, by its `type`.
+    pub(crate) enum LightDesc {
+        tag: "type", family: ("light", "lights"), default: None, shared: LightMotion,
+        Point(PointLight) = "point",
+        Spot(SpotLight) = "spot",
+        Distant(DistantLight) = "distant",
+        Sphere(SphereLight) = "sphere",
+        Quad(QuadLight) = "quad",
+        Line(LineLight) = "line",
+        /// A volume light filling a box.
+        Box(BoxLight) = "box",
+    }
+}
+
+/// The path a light moves along in animations; see
+/// [`crate::light::Keyframes`]. Every type takes it; a distant light, which
+/// has no position, refuses it when built.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct LightMotion {
     pub keyframes: Option<Spanned<Vec<Spanned<KeyframeDesc>>>>,
+}
+
+/// How a point, spot or sphere light falls off with distance: the model,
+/// the light's radius (for the physical model's near field), the
+/// irradiance below which a finite-range falloff drops the light, and
+/// d_max, how far from its surface it reaches. Each of the three types
+/// declares these keys (serde cannot flatten a struct whose keys are
+/// checked).
+macro_rules! falloff_keys {
+    ($(#[$meta:meta])* pub(crate) struct $name:ident { $($field:ident: $ty:ty,)* }) => {
+        $(#[$meta])*
+        #[derive(Debug, Deserialize)]
+        #[serde(deny_unknown_fields)]
+        pub(crate) struct $name {
+            $(pub $field: $ty,)*
+            pub attenuation: Option<AttenuationModel>,
+            pub radius: Option<f32>,
+            pub cutoff: Option<f32>,
+            pub range: Option<f32>,
+        }
+
+        impl $name {
+            pub(crate) fn falloff(&self) -> Falloff {
+                Falloff { model: self.attenuation, radius: self.radius, cutoff: self.cutoff, range: self.range }
+            }
+        }
+    };
+}
+
+/// A point, spot or sphere light's falloff keys, as given.
+pub(crate) struct Falloff {
+    pub model: Option<AttenuationModel>,
+    pub radius: Option<f32>,
+    pub cutoff: Option<f32>,
+    pub range: Option<f32>,
+}
+
+falloff_keys! {
+    pub(crate) struct PointLight {
+        position: Point,
+        intensity: Triple,
+    }
+}
+
+falloff_keys! {
+    /// Aimed by `direction` or `look_at`; its cone's half-angle and where
+    /// the falloff to its edge starts, in degrees.
+    pub(crate) struct SpotLight {
+        position: Point,
+        intensity: Triple,
+        direction: Option<Point>,
+        look_at: Option<Point>,
+        cone_angle: Option<f32>,
+        falloff_start: Option<f32>,
+        profile: Option<SpotProfileDesc>,
+    }
+}
+
+falloff_keys! {
+    /// A surface of `radiance`, or with `volume = true` a glowing ball of
+    /// `intensity` (which takes no falloff).
+    pub(crate) struct SphereLight {
+        center: Point,
+        radiance: Option<Triple>,
+        volume: Option<bool>,
+        intensity: Option<Triple>,
+    }
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct DistantLight {
+    pub direction: Point,
+    pub irradiance: Triple,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct QuadLight {
+    pub corner: Point,
+    pub edge_u: Point,
+    pub edge_v: Point,
+    pub radiance: Triple,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct LineLight {
+    pub start: Point,
+    pub end: Point,
+    pub intensity: Triple,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct BoxLight {
+    pub min: Point,
+    pub max: Point,
+    pub intensity: Triple,
 }
 
 /// One key of a moving light: `{ time = 0.0, position = [x, y, z] }`.

@@ -29,6 +29,7 @@ mod mtl;
 pub mod obj;
 mod sdf;
 mod settings;
+mod tables;
 mod texture_file;
 mod warnings;
 

@@ -22,8 +22,9 @@ fn a_medium_from_command_line_options_follows_the_scene_file_rules() {
     for (options, message) in [
         ("g = 1", "medium.g must lie strictly between -1 and 1, got 1"),
         ("sigma_s = -1", "medium.sigma_s must be finite and ≥ 0, got [-1, -1, -1]"),
-        ("falloff = 1", "base and falloff belong to a `height` medium, not a homogeneous one"),
-        ("density = 1", "unknown field `density`"),
+        ("falloff = 1", "`falloff` is a key of height or noise media, not of homogeneous media"),
+        ("density = 1", "`density` is not a key of homogeneous media; they take sigma_a, sigma_s, g"),
+        ("type = \"grid\", file = \"a.vol\", density_scael = 2", "did you mean `density_scale`?"),
     ] {
         let e = medium_from_options(options).unwrap_err();
         assert!(e.contains(message), "{options}: {e}");

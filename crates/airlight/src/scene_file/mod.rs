@@ -71,12 +71,7 @@ fn check_render_keys(render: &RenderDesc, text: &str) -> Result<(), SceneError> 
         if known.contains(&name) {
             continue;
         }
-        let hint = known
-            .iter()
-            .filter(|k| edit_distance(k, name) <= 2)
-            .min_by_key(|k| edit_distance(k, name))
-            .map(|k| format!("did you mean `{k}`? "))
-            .unwrap_or_default();
+        let hint = crate::options::nearest(name, &known).map(|k| format!("did you mean `{k}`? ")).unwrap_or_default();
         return Err(SceneError::at(
             text,
             key.span().start,
@@ -109,22 +104,6 @@ fn integrator_options(render: &RenderDesc, has_medium: bool, text: &str) -> Resu
         }
     }
     Ok(desc)
-}
-
-/// The Levenshtein distance of two keys (ASCII), for "did you mean".
-fn edit_distance(a: &str, b: &str) -> usize {
-    let (a, b) = (a.as_bytes(), b.as_bytes());
-    let mut row: Vec<usize> = (0..=b.len()).collect();
-    for (i, &ca) in a.iter().enumerate() {
-        let mut diagonal = row[0];
-        row[0] = i + 1;
-        for (j, &cb) in b.iter().enumerate() {
-            let above = row[j + 1];
-            row[j + 1] = (diagonal + usize::from(ca != cb)).min(above + 1).min(row[j] + 1);
-            diagonal = above;
-        }
-    }
-    row[b.len()]
 }
 
 /// Whether `path` names a glTF file (`.gltf` or `.glb`, any case).
