@@ -162,7 +162,11 @@ fn cases() -> Vec<(String, usize, &'static str)> {
             "`albedo2` is a key of checker materials, not of diffuse materials",
         ),
         // 27. Perspective camera with a view_height.
-        (with("[camera]\nview_height = 3"), 2, "view_height is for orthographic cameras"),
+        (
+            with("[camera]\nview_height = 3"),
+            2,
+            "`view_height` is a key of orthographic or isometric cameras, not of perspective cameras",
+        ),
         // 28. Camera looking at itself.
         (
             with("[camera]\nposition = [1, 1, 1]\nlook_at = [1, 1, 1]"),
@@ -198,7 +202,9 @@ fn cases() -> Vec<(String, usize, &'static str)> {
             20,
             "lights[1] (point): `cone_angle` is a key of spot lights, not of point lights",
         ),
-        // 33. A key no type takes, a slip away from one this type takes.
+        // 33. An isometric camera's key on a perspective one (once ignored).
+        (with("[camera]\ndistance = 20"), 2, "`distance` is a key of isometric cameras, not of perspective cameras"),
+        // 34. A key no type takes, a slip away from one this type takes.
         (
             format!("{GOOD_TAIL}\n[[lights]]\ntype = \"point\"\nposition = [0, 3, 0]\nintensity = 5\nintensty = 5\n"),
             20,

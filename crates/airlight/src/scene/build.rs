@@ -104,8 +104,8 @@ impl Checker<'_> {
         if let Some((camera, _)) = included_camera {
             builder = builder.camera(camera);
         }
-        if let Some(camera) = &desc.camera {
-            builder = builder.camera(self.camera(camera)?);
+        if desc.camera.is_some() {
+            builder = builder.camera(self.camera()?);
         }
         if desc.medium.is_some() {
             builder = builder.medium(self.medium()?);

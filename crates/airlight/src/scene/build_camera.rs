@@ -8,33 +8,50 @@ use super::desc::*;
 use super::limits;
 use crate::camera::{Camera, Projection};
 use glam::Vec3;
-use toml::Spanned;
 
 impl Checker<'_> {
-    pub(super) fn camera(&self, desc: &Spanned<CameraDesc>) -> Result<Camera> {
-        let span = desc.span();
-        let c = desc.get_ref();
+    /// The camera `[camera]` describes, read by its type.
+    pub(super) fn camera(&self) -> Result<Camera> {
+        let read = self.read_table::<CameraDesc>(self.section("camera")?, "camera")?;
+        let span = read.table.span();
+        let c = &read.shared;
         let point = |v: Option<Point>, name: &str, default: Vec3| -> Result<Vec3> {
             self.finite3(span.clone(), &format!("camera.{name}"), v.map_or(default, |p| p.0))
         };
         let default = default_camera();
         let look_at = point(c.look_at, "look_at", Vec3::new(0.0, 1.0, 0.0))?;
         let up = self.direction(span.clone(), "camera.up", c.up.map_or(Vec3::Y, |p| p.0))?;
-        let position = match c.kind {
-            CameraType::Isometric => {
-                if c.position.is_some() {
-                    return Err(self.err(span, "an isometric camera is placed by look_at and distance, not position"));
+        let view_height = |h: Option<f32>| self.positive(span.clone(), "camera.view_height", h.unwrap_or(10.0));
+        let (position, projection) = match &read.kind {
+            CameraDesc::Perspective(p) => {
+                let fov = p.fov.unwrap_or(40.0);
+                if !(fov > 0.0 && fov < 180.0) {
+                    return Err(self.err_field(
+                        span,
+                        "fov",
+                        format!("camera.fov must be between 0 and 180 degrees, got {fov}"),
+                    ));
                 }
-                let distance = self.positive(span.clone(), "camera.distance", c.distance.unwrap_or(50.0))?;
-                look_at - crate::camera::ISOMETRIC_VIEW * distance
+                (point(p.position, "position", default.position)?, Projection::Perspective { fov_degrees: fov })
             }
-            _ => point(c.position, "position", default.position)?,
+            CameraDesc::Orthographic(o) => (
+                point(o.position, "position", default.position)?,
+                Projection::Orthographic { view_height: view_height(o.view_height)? },
+            ),
+            CameraDesc::Isometric(i) => {
+                let distance = self.positive(span.clone(), "camera.distance", i.distance.unwrap_or(50.0))?;
+                (
+                    look_at - crate::camera::ISOMETRIC_VIEW * distance,
+                    Projection::Orthographic { view_height: view_height(i.view_height)? },
+                )
+            }
         };
+        let isometric = matches!(read.kind, CameraDesc::Isometric(_));
         for (name, p) in [("position", position), ("look_at", look_at)] {
             let extent = limits::reach_of(p);
             if extent > limits::MAX_COORDINATE {
                 // An isometric camera's position comes from its distance.
-                let name = if c.kind == CameraType::Isometric && name == "position" { "distance" } else { name };
+                let name = if isometric && name == "position" { "distance" } else { name };
                 return Err(self.err_field(span.clone(), name, limits::too_far(&format!("camera.{name}"), extent)));
             }
         }
@@ -55,37 +72,6 @@ impl Checker<'_> {
         if limits::sin_between(forward, up) < 1e-6 {
             return Err(self.err_field(span, "up", "camera.up must not be parallel to the view direction"));
         }
-        let projection = match c.kind {
-            CameraType::Perspective => {
-                if c.view_height.is_some() {
-                    return Err(self.err_field(
-                        span,
-                        "view_height",
-                        "view_height is for orthographic cameras; a perspective camera takes fov",
-                    ));
-                }
-                let fov = c.fov.unwrap_or(40.0);
-                if !(fov > 0.0 && fov < 180.0) {
-                    return Err(self.err_field(
-                        span,
-                        "fov",
-                        format!("camera.fov must be between 0 and 180 degrees, got {fov}"),
-                    ));
-                }
-                Projection::Perspective { fov_degrees: fov }
-            }
-            CameraType::Orthographic | CameraType::Isometric => {
-                if c.fov.is_some() {
-                    return Err(self.err_field(
-                        span,
-                        "fov",
-                        "fov is for perspective cameras; an orthographic camera takes view_height",
-                    ));
-                }
-                let h = self.positive(span.clone(), "camera.view_height", c.view_height.unwrap_or(10.0))?;
-                Projection::Orthographic { view_height: h }
-            }
-        };
         let aperture = self.non_negative(span.clone(), "camera.aperture", c.aperture.unwrap_or(0.0))?;
         let focus = c.focus_distance.unwrap_or(forward.length());
         let focus = self.positive(span.clone(), "camera.focus_distance", focus)?;

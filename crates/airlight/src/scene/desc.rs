@@ -20,9 +20,9 @@ use toml::Spanned;
 pub struct SceneDesc {
     #[serde(default)]
     pub render: RenderDesc,
-    pub camera: Option<Spanned<CameraDesc>>,
     // The tables below are read by their type's struct when the scene is
     // built ([`super::tables`]); here only their places are kept.
+    pub camera: Option<Spanned<TableAt>>,
     pub medium: Option<Spanned<TableAt>>,
     #[serde(default)]
     pub materials: BTreeMap<String, Spanned<TableAt>>,
@@ -65,32 +65,49 @@ impl RenderDesc {
     }
 }
 
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum CameraType {
-    Perspective,
-    Orthographic,
-    Isometric,
+tagged! {
+    /// The `[camera]` table, by its `type`.
+    pub(crate) enum CameraDesc {
+        tag: "type", family: ("camera", "cameras"), default: Some("perspective"), shared: Aim,
+        Perspective(PerspectiveCamera) = "perspective",
+        Orthographic(OrthographicCamera) = "orthographic",
+        /// An orthographic camera looking down the isometric diagonal at
+        /// `look_at`, from `distance` back.
+        Isometric(IsometricCamera) = "isometric",
+    }
+}
+
+/// What every camera has: where it looks, which way is up, and its lens.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct Aim {
+    pub look_at: Option<Point>,
+    pub up: Option<Point>,
+    pub aperture: Option<f32>,
+    pub focus_distance: Option<f32>,
 }
 
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct CameraDesc {
-    #[serde(rename = "type", default = "perspective")]
-    pub kind: CameraType,
+pub(crate) struct PerspectiveCamera {
     pub position: Option<Point>,
-    pub look_at: Option<Point>,
-    pub up: Option<Point>,
+    /// The vertical field of view, in degrees.
     pub fov: Option<f32>,
-    pub view_height: Option<f32>,
-    pub aperture: Option<f32>,
-    pub focus_distance: Option<f32>,
-    /// Isometric only: how far back from look_at the camera stands.
-    pub distance: Option<f32>,
 }
 
-fn perspective() -> CameraType {
-    CameraType::Perspective
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct OrthographicCamera {
+    pub position: Option<Point>,
+    /// The height of the view, in world units.
+    pub view_height: Option<f32>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct IsometricCamera {
+    pub view_height: Option<f32>,
+    pub distance: Option<f32>,
 }
 
 tagged! {
