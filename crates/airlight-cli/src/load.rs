@@ -10,7 +10,7 @@ const DEMO_SCENE: &str = include_str!("../../../scenes/demo.toml");
 /// The scene file at `path`, or the built-in demo scene.
 pub fn load(path: Option<&Path>) -> Result<SceneFile, String> {
     match path {
-        Some(path) => SceneFile::load_with(path, &airlight::scene::AssetPath::from_env()).map_err(|e| e.to_string()),
+        Some(path) => SceneFile::load_with(path, &airlight::assets::AssetPath::from_env()).map_err(|e| e.to_string()),
         None => SceneFile::from_toml_str(DEMO_SCENE, None).map_err(|e| format!("built-in demo scene: {e}")),
     }
 }

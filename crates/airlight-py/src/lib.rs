@@ -9,7 +9,7 @@ mod render;
 mod scene;
 mod shared;
 
-use airlight::scene::AssetPath;
+use airlight::assets::AssetPath;
 use errors::{Origin, guard};
 use numpy::{AllowTypeChange, PyArray3, PyArrayLikeDyn};
 use pyo3::exceptions::{PyOSError, PyValueError};

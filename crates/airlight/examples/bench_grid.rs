@@ -13,7 +13,7 @@
 use airlight::SceneFile;
 use airlight::film::compare;
 use airlight::integrator::{PathOptions, PathTracer};
-use airlight::medium::vol::{self, VolGrid};
+use airlight::assets::vol::{self, VolGrid};
 use airlight::medium::{DensityGrid, Medium};
 use airlight::prelude::*;
 use glam::Affine3A;

@@ -11,7 +11,7 @@
 //! cloud between heights 6 and 9, whose noise cuts gaps for the sun.
 
 use airlight::medium::NoiseFog;
-use airlight::medium::vol::{self, VolGrid};
+use airlight::assets::vol::{self, VolGrid};
 use glam::Vec3;
 
 fn main() -> std::io::Result<()> {

@@ -1,8 +1,9 @@
 //! Airlight: a CPU renderer for light that you can see.
 //!
-//! The library holds the render-time scene ([`Scene`]), its description as read
-//! from TOML ([`scene::SceneDesc`]), geometry with a BVH, lights, participating
-//! media, cameras and the integrators. It knows nothing of terminals: the
+//! The library holds the render-time scene ([`Scene`]), the scene file
+//! format that makes one ([`scene_file`]), the readers of the files a scene
+//! names ([`assets`]: OBJ, MTL, glTF, images, `.vol` grids), geometry with
+//! a BVH, lights, participating media, cameras and the integrators. It knows nothing of terminals: the
 //! `airlight` command is a thin shell around it.
 //!
 //! ```
@@ -28,6 +29,7 @@
 //! [`SceneFile::load`]. The file format, units and conventions are in
 //! docs/scene-format.md.
 
+pub mod assets;
 pub mod camera;
 pub mod film;
 pub mod geometry;
@@ -43,7 +45,7 @@ pub mod radiosity;
 pub mod render;
 pub mod sampling;
 pub mod scene;
-mod scene_file;
+pub mod scene_file;
 mod scratch;
 pub mod texture;
 

@@ -4,7 +4,7 @@
 
 use airlight::SceneFile;
 use airlight::integrator::{IntegratorDesc, IntegratorKind};
-use airlight::medium::vol::{self, VolGrid};
+use airlight::assets::vol::{self, VolGrid};
 use glam::Vec3;
 use std::path::Path;
 

@@ -5,7 +5,7 @@
 
 use airlight::film::Image;
 use airlight::prelude::*;
-use airlight::scene::AssetPath;
+use airlight::assets::AssetPath;
 use std::path::Path;
 
 const TAIL: &str = "[materials.m]\nalbedo = 0.5\n";

@@ -99,7 +99,7 @@ fn parse_medium(s: &str) -> Result<MediumOption, String> {
     if s.trim() == "none" {
         return Ok(MediumOption(None));
     }
-    airlight::scene::medium_from_options(s).map(|m| MediumOption(Some(m)))
+    airlight::scene_file::medium_from_options(s).map(|m| MediumOption(Some(m)))
 }
 
 /// The image outputs: as given, or NAME.png after the scene file.

@@ -36,7 +36,7 @@ use super::engine::Mode;
 use airlight::Camera;
 use airlight::camera::Projection;
 use airlight::light::{Keyframes, Light};
-use airlight::scene::assets::read_text;
+use airlight::assets::read_text;
 use airlight::scene::limits::{MAX_COORDINATE, light_extent, too_far};
 use airlight::scene::{Scene, SceneError};
 use glam::Vec3;

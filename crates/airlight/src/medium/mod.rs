@@ -7,7 +7,6 @@ mod grid;
 pub mod noise;
 mod phase;
 mod profile;
-pub mod vol;
 
 pub use grid::{DensityGrid, MAJORANT_RESOLUTION};
 pub use noise::NoiseFog;

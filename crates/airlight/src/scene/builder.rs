@@ -11,6 +11,16 @@ use crate::medium::Medium;
 use glam::{Affine3A, Vec3};
 use std::collections::HashMap;
 
+/// What a scene file's object table or an included file adds to a scene:
+/// materials by name, surfaces with the names of their materials, and the
+/// lights of emitting surfaces.
+#[derive(Default)]
+pub(crate) struct Parts {
+    pub materials: Vec<(String, Material)>,
+    pub objects: Vec<(Shape, String)>,
+    pub lights: Vec<Light>,
+}
+
 /// Builds a [`Scene`] in Rust, as a World/Camera example in a tutorial would.
 #[derive(Default)]
 pub struct SceneBuilder {
@@ -44,6 +54,13 @@ impl SceneBuilder {
     pub fn with_settings(mut self, change: impl FnOnce(&mut RenderSettings)) -> Self {
         change(&mut self.settings);
         self
+    }
+
+    /// Adds the parts, materials first.
+    pub(crate) fn parts(self, parts: Parts) -> Self {
+        let builder = parts.materials.into_iter().fold(self, |b, (name, m)| b.material(&name, m));
+        let builder = parts.objects.into_iter().fold(builder, |b, (shape, name)| b.object(shape, &name));
+        parts.lights.into_iter().fold(builder, SceneBuilder::light)
     }
 
     pub fn camera(mut self, camera: Camera) -> Self {

@@ -1,5 +1,6 @@
-//! The render-time [`Scene`], the [`SceneBuilder`] that makes one in Rust, and
-//! the TOML scene description ([`SceneDesc`]) that makes one from a file.
+//! The render-time [`Scene`] and the [`SceneBuilder`] that makes one in
+//! Rust. A scene file is read into one by [`crate::SceneFile`]; the files
+//! it names, by [`crate::assets`].
 //!
 //! A scene holds geometry, lights, the medium, the camera and the film
 //! settings; which integrator renders it, with what options, is not its
@@ -8,37 +9,19 @@
 //! moving a light ([`Scene::set_lights`], [`Scene::at_time`]) moves its
 //! visible surface and the shadow it casts, and re-sorts the light culling.
 
-pub mod assets;
-mod build;
-mod build_camera;
-mod build_lights;
-mod build_materials;
-mod build_medium;
-mod build_objects;
 mod builder;
-pub mod desc;
 mod emitters;
 mod error;
-mod gltf;
 mod light_queries;
 pub(crate) use light_queries::toward_sample;
 mod culling;
 pub mod limits;
-mod mesh;
-mod mtl;
-pub mod obj;
-mod sdf;
 mod settings;
-mod tables;
-mod texture_file;
 mod warnings;
 
-pub use assets::AssetPath;
-pub(crate) use build::{build, parse};
-pub use build_materials::medium_from_options;
+pub(crate) use builder::Parts;
 pub use builder::SceneBuilder;
 pub use culling::LightCulling;
-pub use desc::SceneDesc;
 pub use error::{SceneError, line_col};
 pub use settings::{MAX_IMAGE_SIDE, MAX_PIXELS, MAX_SPP, PixelFilter, RENDER_SETTINGS, RenderSettings};
 

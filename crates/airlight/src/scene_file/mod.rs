@@ -1,10 +1,24 @@
 //! Reading a scene file: the scene, and the integrator its `[render]` table
 //! asks for. The scene format is described in docs/scene-format.md.
 
+mod camera;
+mod check;
+pub mod desc;
+mod lights;
+mod materials;
+mod medium;
+mod objects;
+mod sdf;
+mod tables;
+
+pub(crate) use check::{build, parse};
+pub use desc::SceneDesc;
+pub use medium::medium_from_options;
+
+use crate::assets::{AssetPath, read_text};
 use crate::integrator::{INTEGRATOR_OPTIONS, IntegratorDesc, IntegratorKind};
-use crate::scene::assets::read_text;
-use crate::scene::desc::RenderDesc;
-use crate::scene::{self, AssetPath, RENDER_SETTINGS, Scene, SceneError};
+use crate::scene::{RENDER_SETTINGS, Scene, SceneError};
+use desc::RenderDesc;
 use std::path::{Path, PathBuf};
 
 /// A scene file, read and checked: the scene and the integrator it names,
@@ -53,10 +67,10 @@ impl SceneFile {
 
     /// Reads scene file text, with mesh files found in `assets`.
     pub fn from_toml_with(text: &str, assets: &AssetPath) -> Result<SceneFile, SceneError> {
-        let desc = scene::parse(text)?;
+        let desc = parse(text)?;
         check_render_keys(&desc.render, text)?;
         let integrator = integrator_options(&desc.render, desc.medium.is_some(), text)?;
-        let scene = scene::build(&desc, text, assets)?;
+        let scene = build(&desc, text, assets)?;
         Ok(SceneFile { scene, integrator })
     }
 }

@@ -1,15 +1,35 @@
 //! The `[medium]` table: homogeneous fog, height fog, or a density grid
 //! read from a Mitsuba `.vol` file found under the scene's asset folders
-//! ([`super::assets`]). Errors name the scene's line and, for a grid file,
+//! ([`crate::assets`]); and a medium given as one line of its keys (the
+//! command line's `--medium`), checked as the table is. Errors name the scene's line and, for a grid file,
 //! what is wrong with it.
 
-use super::build::{Checker, Result};
-use super::desc::{GridMedium, HomogeneousMedium, MediumDesc, NoiseMedium};
-use super::limits;
+use super::check::{Checker, Result, parse};
+use super::desc::{GridMedium, HomogeneousMedium, MediumDesc, NoiseMedium, SceneDesc};
+use crate::assets::{AssetPath, vol};
 use crate::medium::noise::MAX_OCTAVES;
-use crate::medium::{DensityGrid, Medium, NoiseFog, vol};
+use crate::medium::{DensityGrid, Medium, NoiseFog};
+use crate::scene::{SceneError, limits};
 use glam::Vec3;
 use std::ops::Range;
+
+/// A medium from the keys of a scene file's `[medium]` table written as
+/// one line, `key = value` pairs separated by commas (`sigma_s = 0.05,
+/// sigma_a = 0.01, g = 0.3`; colours as `[r, g, b]`; `type = "height"`),
+/// checked by the same rules as the table. For command lines, which give
+/// a medium without a scene file; a message without a line number. A
+/// grid's `file` is any file the user can read, absolute or relative to
+/// the working directory ([`AssetPath::CommandLine`]).
+pub fn medium_from_options(options: &str) -> Result<Medium, String> {
+    let text = format!("medium = {{ {options} }}");
+    let strip = |e: SceneError| e.message;
+    let desc: SceneDesc = parse(&text).map_err(strip)?;
+    if desc.medium.is_none() {
+        return Err("no medium".into());
+    }
+    let assets = AssetPath::CommandLine;
+    Checker::new(&text, &assets).and_then(|checker| checker.medium()).map_err(strip)
+}
 
 impl Checker<'_> {
     /// The medium `[medium]` describes, read by its type.
@@ -46,7 +66,7 @@ impl Checker<'_> {
         if !name.to_ascii_lowercase().ends_with(".vol") {
             return Err(err("a grid file must be a Mitsuba volume ending in .vol".into()));
         }
-        let path = self.assets.resolve(name).map_err(|why| self.err(file.span(), format!("medium.file: {why}")))?;
+        let path = self.loader.resolve(name).map_err(|why| self.err(file.span(), format!("medium.file: {why}")))?;
         let open = std::fs::File::open(&path).map_err(|e| err(e.to_string()))?;
         let length = open.metadata().map_err(|e| err(e.to_string()))?.len();
         let mut grid = vol::read(std::io::BufReader::new(open), length).map_err(err)?;
@@ -65,7 +85,7 @@ impl Checker<'_> {
         if reach > limits::MAX_COORDINATE {
             return Err(err(limits::too_far("the grid's box", reach)));
         }
-        self.files.borrow_mut().push(path);
+        self.loader.record(path);
         Ok(grid)
     }
 

@@ -14,7 +14,7 @@
 //! ]
 //! ```
 
-use super::build::{Checker, Result};
+use super::check::{Checker, Result};
 use super::desc::{Point, SdfNodeDesc};
 use super::tables::{TableAt, TableValue, element, field};
 use crate::geometry::Sdf;

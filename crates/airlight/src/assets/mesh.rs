@@ -1,37 +1,34 @@
-//! A mesh object's `file`: found under the scene's asset folders
-//! ([`super::assets`]), its size and memory checked, read as OBJ
-//! ([`super::obj`]), with its `.mtl` materials when the scene gives the
-//! object none ([`super::mtl`]). Errors name the scene's line and the mesh
-//! file's.
+//! A mesh object's `file`: found under the scene's asset folders, its size
+//! and memory checked, read as OBJ ([`super::obj`]), with its `.mtl`
+//! materials when the scene gives the object none ([`super::mtl`]).
+//! Errors name the mesh file's line; the caller adds the scene's.
 
-use super::assets::{MAX_MESH_BYTES, read_limited};
-use super::build::{Checker, Result};
 use super::mtl::{self, MtlMaterial};
 use super::obj::{self, Obj};
+use super::{Loader, MAX_MESH_BYTES, read_limited};
 use crate::geometry::Shape;
 use crate::texture::Texture;
 use std::collections::HashMap;
 use std::path::Path;
 use std::sync::Arc;
-use toml::Spanned;
 
 /// Largest `.mtl` file read.
 const MAX_MTL_BYTES: u64 = 64 << 20;
 
 /// The triangles of an OBJ mesh that share one `.mtl` material (None: the
 /// faces before any `usemtl`).
-pub(super) struct MeshPart {
+pub(crate) struct MeshPart {
     pub shape: Shape,
     pub material: Option<MtlMaterial>,
     /// Its material's `map_Kd`, read.
     pub texture: Option<Arc<Texture>>,
 }
 
-impl Checker<'_> {
+impl Loader<'_> {
     /// The mesh, all of it, with its texture coordinates if every face
     /// has them; its materials unread.
-    pub(super) fn mesh(&self, label: &str, file: &Spanned<String>) -> Result<Shape> {
-        let obj = self.load_obj(label, file)?;
+    pub(crate) fn mesh(&self, name: &str) -> Result<Shape, String> {
+        let obj = self.load_obj(name)?;
         if obj.triangle_texcoords.is_empty() {
             return Ok(Shape::Mesh { positions: obj.positions, triangles: obj.triangles, uvs: Vec::new() });
         }
@@ -41,27 +38,22 @@ impl Checker<'_> {
     /// The mesh cut into one part per `.mtl` material its faces use, the
     /// libraries (`mtllib`) found beside the OBJ file, under the same
     /// rules as the OBJ itself.
-    pub(super) fn mesh_parts(&self, label: &str, file: &Spanned<String>) -> Result<Vec<MeshPart>> {
-        let obj = self.load_obj(label, file)?;
-        let path = Path::new(file.get_ref());
-        let fail_at = |line: usize, why: String| {
-            self.err(file.span(), format!("{label}: cannot load mesh {}:{line}: {why}", path.display()))
-        };
+    pub(crate) fn mesh_parts(&self, name: &str) -> Result<Vec<MeshPart>, String> {
+        let obj = self.load_obj(name)?;
+        let path = Path::new(name);
+        let fail_at = |line: usize, why: String| format!("cannot load mesh {}:{line}: {why}", path.display());
         let mut library: Vec<MtlMaterial> = Vec::new();
         let mut library_of: HashMap<String, std::path::PathBuf> = HashMap::new();
         for (name, line) in &obj.libraries {
             let beside = path.parent().unwrap_or(Path::new("")).join(name);
-            let mtl_path = self.assets.resolve(&beside.to_string_lossy()).map_err(|why| fail_at(*line, why))?;
+            let mtl_path = self.resolve(&beside.to_string_lossy()).map_err(|why| fail_at(*line, why))?;
             let bytes =
                 read_limited(&mtl_path, MAX_MTL_BYTES).map_err(|why| fail_at(*line, format!("{name}: {why}")))?;
             let text = String::from_utf8_lossy(&bytes);
             let mut materials = mtl::parse(&text).map_err(|e| {
-                self.err(
-                    file.span(),
-                    format!("{label}: cannot load material library {}:{}: {}", mtl_path.display(), e.line, e.message),
-                )
+                format!("cannot load material library {}:{}: {}", mtl_path.display(), e.line, e.message)
             })?;
-            self.files.borrow_mut().push(mtl_path.clone());
+            self.record(mtl_path.clone());
             // Texture maps are named relative to their library.
             for m in &mut materials {
                 if let Some((map, _)) = &mut m.diffuse_map {
@@ -96,13 +88,13 @@ impl Checker<'_> {
         let textured = |m: &Option<MtlMaterial>| {
             !obj.triangle_texcoords.is_empty() && m.as_ref().is_some_and(|m| m.diffuse_map.is_some())
         };
-        let texture_of = |m: &Option<MtlMaterial>| -> Result<Option<Arc<Texture>>> {
+        let texture_of = |m: &Option<MtlMaterial>| -> Result<Option<Arc<Texture>>, String> {
             let Some((m, (map, line))) = m.as_ref().and_then(|m| Some(m).zip(m.diffuse_map.as_ref())) else {
                 return Ok(None);
             };
             self.texture_file(map).map(Some).map_err(|why| {
                 let mtl = library_of.get(&m.name).map_or(String::new(), |p| p.display().to_string());
-                self.err(file.span(), format!("{label}: cannot load material library {mtl}:{line}: map_Kd: {why}"))
+                format!("cannot load material library {mtl}:{line}: map_Kd: {why}")
             })
         };
         if let [(material, _)] = &mut groups[..]
@@ -121,29 +113,19 @@ impl Checker<'_> {
         Ok(parts)
     }
 
-    fn load_obj(&self, label: &str, file: &Spanned<String>) -> Result<Obj> {
-        let name = file.get_ref();
-        let path = self
-            .assets
-            .resolve(name)
-            .map_err(|why| self.err(file.span(), format!("{label}: cannot load mesh: {why}")))?;
-        let fail =
-            |why: String| self.err(file.span(), format!("{label}: cannot load mesh `{}`: {why}", path.display()));
+    fn load_obj(&self, name: &str) -> Result<Obj, String> {
+        let path = self.resolve(name).map_err(|why| format!("cannot load mesh: {why}"))?;
+        let fail = |why: String| format!("cannot load mesh `{}`: {why}", path.display());
         let bytes = read_limited(&path, MAX_MESH_BYTES).map_err(fail)?;
         let (vertices, triangles) = obj::count(&bytes);
         // Meshes add up: the scene's total is what must fit.
-        let bytes_needed =
-            self.mesh_bytes.get() + vertices.saturating_mul(12) + triangles.saturating_mul(obj::BYTES_PER_TRIANGLE);
-        crate::memory::check(format!("the scene's meshes ({triangles} triangles in this one)"), bytes_needed)
-            .map_err(|e| fail(e.to_string()))?;
-        self.mesh_bytes.set(bytes_needed);
+        let needed = vertices.saturating_mul(12).saturating_add(triangles.saturating_mul(obj::BYTES_PER_TRIANGLE));
+        self.reserve(needed, || format!("the scene's meshes ({triangles} triangles in this one)")).map_err(fail)?;
         let mesh = obj::parse(&bytes, vertices, triangles).map_err(|e| match e.line {
             0 => fail(e.message),
-            line => {
-                self.err(file.span(), format!("{label}: cannot load mesh {}:{line}: {}", path.display(), e.message))
-            }
+            line => format!("cannot load mesh {}:{line}: {}", path.display(), e.message),
         })?;
-        self.files.borrow_mut().push(path);
+        self.record(path);
         Ok(mesh)
     }
 }

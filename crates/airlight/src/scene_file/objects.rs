@@ -2,32 +2,22 @@
 //! (transform), its material and, for emitting surfaces, its lights; and
 //! each `[[include]]`d glTF file's meshes.
 
-use super::build::{Checker, Result};
+use super::check::{Checker, Result};
 use super::desc::*;
-use super::gltf;
-use super::limits;
 use crate::Rgb;
+use crate::assets::{GltfInclude, Imported, MeshPart};
 use crate::geometry::Shape;
 use crate::light::Light;
 use crate::material::Material;
+use crate::scene::{Parts, limits};
 use glam::{Affine3A, Quat, Vec3};
 use std::ops::Range;
 use toml::Spanned;
 
-/// What one `[[objects]]` table builds: surfaces with the names of their
-/// materials, the materials it brings (an OBJ's `.mtl`), and the lights
-/// of emitting surfaces.
-#[derive(Default)]
-pub(super) struct Built {
-    pub materials: Vec<(String, Material)>,
-    pub objects: Vec<(Shape, String)>,
-    pub lights: Vec<Light>,
-}
-
 impl Checker<'_> {
     /// The `index`th `[[objects]]` table read by its type, and what it
     /// builds.
-    pub(super) fn object(&self, index: usize, scene: &SceneDesc) -> Result<Built> {
+    pub(super) fn object(&self, index: usize, scene: &SceneDesc) -> Result<Parts> {
         let label = format!("objects[{index}]");
         let read = self.read_table::<ObjectDesc>(self.section_element("objects", index)?, &label)?;
         let label = format!("{label} ({})", read.name);
@@ -79,7 +69,7 @@ impl Checker<'_> {
             }
             let placed = self.placed(span.clone(), &label, shape.transformed(transform))?;
             let lights = self.emitter(span, &label, placed, radiance)?;
-            return Ok(Built { lights, ..Built::default() });
+            return Ok(Parts { lights, ..Parts::default() });
         }
         let material = match &o.material {
             Some(name) => {
@@ -97,17 +87,12 @@ impl Checker<'_> {
             }
         };
         let objects = vec![(self.placed(span, &label, shape.transformed(transform))?, material)];
-        Ok(Built { objects, ..Built::default() })
+        Ok(Parts { objects, ..Parts::default() })
     }
 
     /// One `[[include]]`: a glTF file, or an OBJ file as a mesh object
     /// would take it.
-    pub(super) fn include(
-        &self,
-        index: usize,
-        desc: &Spanned<IncludeDesc>,
-        scene: &SceneDesc,
-    ) -> Result<gltf::Imported> {
+    pub(super) fn include(&self, index: usize, desc: &Spanned<IncludeDesc>, scene: &SceneDesc) -> Result<Imported> {
         let span = desc.span();
         let d = desc.get_ref();
         let label = format!("include[{index}]");
@@ -130,16 +115,18 @@ impl Checker<'_> {
             let built = match material {
                 Some(name) => {
                     let shape = self.placed(span, &label, self.mesh(&label, &d.file)?.transformed(transform))?;
-                    Built { objects: vec![(shape, name.to_string())], ..Built::default() }
+                    Parts { objects: vec![(shape, name.to_string())], ..Parts::default() }
                 }
                 None => self.mesh_with_materials(span, &label, &d.file, transform)?,
             };
-            return Ok(gltf::Imported { built, camera: None });
+            return Ok(Imported { parts: built, camera: None });
         }
         if !(file.ends_with(".gltf") || file.ends_with(".glb")) {
             return Err(self.err(d.file.span(), format!("{label}: `file` must be a .gltf, .glb or .obj file")));
         }
-        self.gltf(&gltf::Include { label: &label, file: &d.file, scene: d.scene.as_deref(), transform, material })
+        let include =
+            GltfInclude { label: &label, file: d.file.get_ref(), scene: d.scene.as_deref(), transform, material };
+        self.loader.gltf(&include).map_err(|why| self.err(d.file.span(), why))
     }
 
     /// A mesh object without a `material`: its faces take the `.mtl`
@@ -151,10 +138,10 @@ impl Checker<'_> {
         label: &str,
         file: &Spanned<String>,
         transform: Affine3A,
-    ) -> Result<Built> {
+    ) -> Result<Parts> {
         let parts = self.mesh_parts(label, file)?;
         let only_part = parts.len() == 1;
-        let mut built = Built::default();
+        let mut built = Parts::default();
         for part in parts {
             let texture = part.texture;
             let Some(m) = part.material else {
@@ -183,6 +170,16 @@ impl Checker<'_> {
             }
         }
         Ok(built)
+    }
+
+    /// The mesh in the OBJ file `file`, all of it.
+    fn mesh(&self, label: &str, file: &Spanned<String>) -> Result<Shape> {
+        self.loader.mesh(file.get_ref()).map_err(|why| self.err(file.span(), format!("{label}: {why}")))
+    }
+
+    /// The mesh in the OBJ file `file`, one part per `.mtl` material.
+    fn mesh_parts(&self, label: &str, file: &Spanned<String>) -> Result<Vec<MeshPart>> {
+        self.loader.mesh_parts(file.get_ref()).map_err(|why| self.err(file.span(), format!("{label}: {why}")))
     }
 
     /// The lights an emitting object becomes: a sphere light, a quad light,

@@ -1,14 +1,12 @@
 //! From a scene file to a [`Scene`]: parse, check every value, load meshes.
 //! Each error names the place in the file and what was expected.
 
-use super::assets::AssetPath;
 use super::desc::*;
-use super::limits;
-use super::{MAX_IMAGE_SIDE, RENDER_SETTINGS, RenderSettings, Scene, SceneBuilder, SceneError};
+use crate::assets::{AssetPath, Loader};
+use crate::scene::{MAX_IMAGE_SIDE, RENDER_SETTINGS, RenderSettings, Scene, SceneBuilder, SceneError, limits};
 use glam::Vec3;
-use std::cell::{Cell, RefCell};
+use std::cell::RefCell;
 use std::ops::Range;
-use std::path::PathBuf;
 
 /// Parses scene file text into its description; errors name the line and
 /// column (unknown keys at the key).
@@ -29,37 +27,38 @@ pub fn parse(text: &str) -> Result<SceneDesc, SceneError> {
 pub fn build(desc: &SceneDesc, text: &str, assets: &AssetPath) -> Result<Scene, SceneError> {
     // The same text parsed to a spanned document: where each key and value
     // stands, for errors found after deserializing.
-    let document = toml::de::DeTable::parse(text).map(|d| d.into_inner()).unwrap_or_default();
-    let checker = Checker {
-        text,
-        assets,
-        document,
-        files: RefCell::default(),
-        mesh_bytes: Cell::new(0),
-        notes: RefCell::default(),
-        textures: RefCell::default(),
-    };
+    let checker = Checker::new(text, assets)?;
     let mut scene = checker.scene(desc)?;
-    scene.files = checker.files.into_inner();
+    scene.files = checker.loader.into_files();
     scene.notes = checker.notes.into_inner();
     Ok(scene)
 }
 
+/// The checks and building of one scene file: its text, where each value
+/// stands in it, and the files it reads.
 pub(super) struct Checker<'a> {
     pub(super) text: &'a str,
-    pub(super) assets: &'a AssetPath,
+    /// The text parsed to a spanned document: where each key and value
+    /// stands, for errors found after deserializing, and the tables read
+    /// by their types' structs ([`super::tables`]).
     pub(super) document: toml::de::DeTable<'a>,
-    /// The files read so far (meshes).
-    pub(super) files: RefCell<Vec<PathBuf>>,
-    /// Memory the meshes read so far will take.
-    pub(super) mesh_bytes: Cell<u64>,
+    /// The files the scene names.
+    pub(super) loader: Loader<'a>,
     /// What was asked for and is not done (see [`Scene::notes`]).
     pub(super) notes: RefCell<Vec<String>>,
-    /// Image files read as textures, so that each is read once.
-    pub(super) textures: RefCell<Vec<(PathBuf, std::sync::Arc<crate::texture::Texture>)>>,
 }
 
 pub(super) type Result<T, E = SceneError> = std::result::Result<T, E>;
+
+impl<'a> Checker<'a> {
+    pub(super) fn new(text: &'a str, assets: &'a AssetPath) -> Result<Self> {
+        let document = toml::de::DeTable::parse(text).map_err(|e| {
+            let at = e.span().map_or(0, |s| s.start);
+            SceneError::at(text, at, e.message().trim_end())
+        })?;
+        Ok(Checker { text, document: document.into_inner(), loader: Loader::new(assets), notes: RefCell::default() })
+    }
+}
 
 impl Checker<'_> {
     pub(super) fn err(&self, span: Range<usize>, message: impl Into<String>) -> SceneError {
@@ -114,16 +113,10 @@ impl Checker<'_> {
             builder = builder.material(name, self.material(name)?);
         }
         for i in 0..desc.objects.len() {
-            let built = self.object(i, desc)?;
-            builder = built.materials.into_iter().fold(builder, |b, (name, m)| b.material(&name, m));
-            builder = built.objects.into_iter().fold(builder, |b, (shape, name)| b.object(shape, &name));
-            builder = built.lights.into_iter().fold(builder, SceneBuilder::light);
+            builder = builder.parts(self.object(i, desc)?);
         }
         for imported in included {
-            let built = imported.built;
-            builder = built.materials.into_iter().fold(builder, |b, (name, m)| b.material(&name, m));
-            builder = built.objects.into_iter().fold(builder, |b, (shape, name)| b.object(shape, &name));
-            builder = built.lights.into_iter().fold(builder, SceneBuilder::light);
+            builder = builder.parts(imported.parts);
         }
         for i in 0..desc.lights.len() {
             let (light, motion) = self.light(i)?;

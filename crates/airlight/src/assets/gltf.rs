@@ -5,25 +5,23 @@
 //! makes of each is in docs/scene-format.md ("glTF scenes").
 //!
 //! Buffers in files are found beside the glTF file under the asset rules
-//! ([`super::assets`]); data URIs are decoded. Every accessor read is
+//! ([`super::AssetPath`]); data URIs are decoded. Every accessor read is
 //! checked against its buffer first, so a short or lying file gives an
 //! error, never a panic. Errors name the file, the JSON path
 //! (`meshes[2].primitives[0]`) and what is wrong.
 
-use super::assets::{MAX_MESH_BYTES, read_limited};
-use super::build::{Checker, Result};
-use super::build_objects::Built;
+use super::{Loader, MAX_MESH_BYTES, read_limited};
 use crate::camera::Camera;
 use crate::geometry::Shape;
 use crate::light::{Attenuation, Light, SpotProfile};
 use crate::material::Material;
+use crate::scene::{Parts, limits};
 use crate::texture::{Texture, Wrap};
 use base64::Engine;
 use glam::{Affine3A, Mat4, Vec2, Vec3};
 use std::collections::HashMap;
 use std::path::Path;
 use std::sync::Arc;
-use toml::Spanned;
 
 /// Luminous efficacy used to turn glTF's photometric light units into
 /// radiometric ones: 683 lm/W, that of light at 555 nm (the definition of
@@ -41,32 +39,34 @@ const MAX_DEPTH: usize = 256;
 const MAX_PLACED_NODES: u64 = 1 << 20;
 
 /// What a glTF file adds to a scene.
-pub(super) struct Imported {
-    pub built: Built,
+pub(crate) struct Imported {
+    pub parts: Parts,
     /// The first camera met, with its aspect ratio when the file gives one.
     pub camera: Option<(Camera, Option<f32>)>,
 }
 
-/// What is being imported and how: the include's label, file, scene name,
-/// transform and material override.
-pub(super) struct Include<'a> {
+/// What is being imported and how: the include's label (for messages),
+/// file, scene name, transform and material override.
+pub(crate) struct GltfInclude<'a> {
     pub label: &'a str,
-    pub file: &'a Spanned<String>,
+    pub file: &'a str,
     pub scene: Option<&'a str>,
     pub transform: Affine3A,
     pub material: Option<&'a str>,
 }
 
-impl Checker<'_> {
-    pub(super) fn gltf(&self, include: &Include) -> Result<Imported> {
-        let name = include.file.get_ref();
-        let fail = |why: String| self.err(include.file.span(), format!("{}: `{name}`: {why}", include.label));
-        let path = self.assets.resolve(name).map_err(|why| fail(format!("cannot load: {why}")))?;
+impl Loader<'_> {
+    /// The glTF file's scene, placed; errors are whole messages (the
+    /// caller places them in the scene file).
+    pub(crate) fn gltf(&self, include: &GltfInclude) -> Result<Imported, String> {
+        let name = include.file;
+        let fail = |why: String| format!("{}: `{name}`: {why}", include.label);
+        let path = self.resolve(name).map_err(|why| fail(format!("cannot load: {why}")))?;
         let bytes = read_limited(&path, MAX_MESH_BYTES).map_err(|why| fail(format!("cannot load: {why}")))?;
         // The crate validates the document, and refuses one that requires
         // an extension other than those Airlight reads (Cargo.toml).
         let gltf = gltf::Gltf::from_slice(&bytes).map_err(|e| fail(format!("not a valid glTF file: {e}")))?;
-        self.files.borrow_mut().push(path);
+        self.record(path);
         let buffers = self.gltf_buffers(&gltf, Path::new(name)).map_err(fail)?;
         let scene = match include.scene {
             Some(wanted) => gltf.scenes().find(|s| s.name() == Some(wanted)).ok_or_else(|| {
@@ -83,13 +83,11 @@ impl Checker<'_> {
         // Memory: the triangles of every mesh each time a node places it,
         // counted before any is read (a mesh may be placed many times).
         let triangles = placed_triangles(&scene).map_err(&fail)?;
-        let needed =
-            self.mesh_bytes.get().saturating_add(triangles.saturating_mul(super::obj::BYTES_PER_TRIANGLE + 36));
-        crate::memory::check(format!("the scene's meshes ({triangles} triangles placed by this glTF)"), needed)
-            .map_err(|e| fail(e.to_string()))?;
-        self.mesh_bytes.set(needed);
+        let bytes = triangles.saturating_mul(super::obj::BYTES_PER_TRIANGLE + 36);
+        self.reserve(bytes, || format!("the scene's meshes ({triangles} triangles placed by this glTF)"))
+            .map_err(fail)?;
 
-        let mut out = Imported { built: Built::default(), camera: None };
+        let mut out = Imported { parts: Parts::default(), camera: None };
         let mut textures = Textures { file: Path::new(name), buffers: &buffers, read: HashMap::new() };
         let mut stack: Vec<(gltf::Node, Affine3A, usize)> =
             scene.nodes().map(|n| (n, include.transform, 0)).collect::<Vec<_>>();
@@ -108,7 +106,7 @@ impl Checker<'_> {
                 self.gltf_mesh(include, &mesh, world, &mut textures, &mut out).map_err(&fail)?;
             }
             if let Some(light) = node.light() {
-                out.built.lights.push(gltf_light(&light, world).map_err(|why| fail(format!("{at}: {why}")))?);
+                out.parts.lights.push(gltf_light(&light, world).map_err(|why| fail(format!("{at}: {why}")))?);
             }
             if let (Some(camera), None) = (node.camera(), &out.camera) {
                 out.camera = Some(gltf_camera(&camera, world).map_err(|why| fail(format!("{at}: {why}")))?);
@@ -123,7 +121,7 @@ impl Checker<'_> {
     /// Each buffer's bytes: the GLB's BIN chunk (the first buffer's only, as
     /// the specification says: each other one would be a copy of it), a
     /// data URI, or a file beside the glTF file (its URI percent-decoded).
-    fn gltf_buffers(&self, gltf: &gltf::Gltf, file: &Path) -> std::result::Result<Vec<Vec<u8>>, String> {
+    fn gltf_buffers(&self, gltf: &gltf::Gltf, file: &Path) -> Result<Vec<Vec<u8>>, String> {
         let mut buffers = Vec::new();
         for buffer in gltf.buffers() {
             let at = format!("buffers[{}]", buffer.index());
@@ -144,9 +142,9 @@ impl Checker<'_> {
                 gltf::buffer::Source::Uri(uri) => {
                     let uri = &percent_decoded(uri);
                     let beside = file.parent().unwrap_or(Path::new("")).join(uri);
-                    let path = self.assets.resolve(&beside.to_string_lossy()).map_err(|why| format!("{at}: {why}"))?;
+                    let path = self.resolve(&beside.to_string_lossy()).map_err(|why| format!("{at}: {why}"))?;
                     let data = read_limited(&path, MAX_MESH_BYTES).map_err(|why| format!("{at}: `{uri}`: {why}"))?;
-                    self.files.borrow_mut().push(path);
+                    self.record(path);
                     data
                 }
             };
@@ -160,12 +158,12 @@ impl Checker<'_> {
 
     fn gltf_mesh(
         &self,
-        include: &Include,
+        include: &GltfInclude,
         mesh: &gltf::Mesh,
         world: Affine3A,
         textures: &mut Textures,
         out: &mut Imported,
-    ) -> std::result::Result<(), String> {
+    ) -> Result<(), String> {
         let buffers = textures.buffers;
         // A mirroring transform turns counter-clockwise front faces clockwise.
         let mirrored = world.matrix3.determinant() < 0.0;
@@ -195,8 +193,8 @@ impl Checker<'_> {
                 return Err(format!("{at}: a vertex is not finite once placed: {p}"));
             }
             // The scene file's rule for every point: within reach of f32.
-            if let Some(p) = positions.iter().find(|p| p.abs().max_element() > super::limits::MAX_COORDINATE) {
-                return Err(super::limits::too_far(&format!("{at}: the vertex {p}"), p.abs().max_element()));
+            if let Some(p) = positions.iter().find(|p| p.abs().max_element() > limits::MAX_COORDINATE) {
+                return Err(limits::too_far(&format!("{at}: the vertex {p}"), p.abs().max_element()));
             }
             let indices: Vec<u32> = match reader.read_indices() {
                 Some(indices) => indices.into_u32().collect(),
@@ -219,7 +217,7 @@ impl Checker<'_> {
                 return Err(format!("{at}: its material's emission is not finite and ≥ 0: {emission}"));
             }
             if emission.max_element() > 0.0 && include.material.is_none() {
-                out.built.lights.extend(Light::triangles_of(&positions, &triangles, emission));
+                out.parts.lights.extend(Light::triangles_of(&positions, &triangles, emission));
                 continue;
             }
             let base_colour = material.pbr_metallic_roughness().base_color_texture();
@@ -229,14 +227,14 @@ impl Checker<'_> {
                 None => {
                     let [r, g, b, _] = material.pbr_metallic_roughness().base_color_factor();
                     let name = match material.index() {
-                        Some(i) => format!("{}#materials[{i}]", include.file.get_ref()),
-                        None => format!("{}#default", include.file.get_ref()),
+                        Some(i) => format!("{}#materials[{i}]", include.file),
+                        None => format!("{}#default", include.file),
                     };
                     if let Some(info) = &base_colour {
                         uvs = texture_coordinates(&primitive, info.tex_coord(), positions.len(), buffers)
                             .map_err(|why| format!("{at}: {why}"))?;
                     }
-                    if !out.built.materials.iter().any(|(n, _)| *n == name) {
+                    if !out.parts.materials.iter().any(|(n, _)| *n == name) {
                         let albedo = Vec3::new(r, g, b);
                         if !(albedo.is_finite() && albedo.min_element() >= 0.0) {
                             return Err(format!("{at}: its base colour is not finite and ≥ 0: {albedo}"));
@@ -251,12 +249,12 @@ impl Checker<'_> {
                             }
                             None => Material::diffuse(albedo),
                         };
-                        out.built.materials.push((name.clone(), m));
+                        out.parts.materials.push((name.clone(), m));
                     }
                     name
                 }
             };
-            out.built.objects.push((Shape::Mesh { positions, triangles, uvs }, name));
+            out.parts.objects.push((Shape::Mesh { positions, triangles, uvs }, name));
         }
         Ok(())
     }
@@ -271,15 +269,11 @@ struct Textures<'a> {
     read: HashMap<usize, Arc<Texture>>,
 }
 
-impl Checker<'_> {
+impl Loader<'_> {
     /// A glTF texture: its image (a file beside the glTF file under the
     /// asset rules, a data URI, or a buffer view), decoded to sRGB texels,
     /// with its sampler's wrap modes; read once per texture.
-    fn gltf_texture(
-        &self,
-        textures: &mut Textures,
-        texture: &gltf::Texture,
-    ) -> std::result::Result<Arc<Texture>, String> {
+    fn gltf_texture(&self, textures: &mut Textures, texture: &gltf::Texture) -> Result<Arc<Texture>, String> {
         if let Some(t) = textures.read.get(&texture.index()) {
             return Ok(t.clone());
         }
@@ -304,9 +298,9 @@ impl Checker<'_> {
             gltf::image::Source::Uri { uri, .. } => {
                 let uri = percent_decoded(uri);
                 let beside = textures.file.parent().unwrap_or(Path::new("")).join(&uri);
-                let path = self.assets.resolve(&beside.to_string_lossy()).map_err(|why| format!("{at}: {why}"))?;
+                let path = self.resolve(&beside.to_string_lossy()).map_err(|why| format!("{at}: {why}"))?;
                 let data = read_limited(&path, MAX_MESH_BYTES).map_err(|why| format!("{at}: `{uri}`: {why}"))?;
-                self.files.borrow_mut().push(path);
+                self.record(path);
                 data
             }
         };
@@ -353,7 +347,7 @@ fn texture_coordinates(
     set: u32,
     vertices: usize,
     buffers: &[Vec<u8>],
-) -> std::result::Result<Vec<Vec2>, String> {
+) -> Result<Vec<Vec2>, String> {
     let accessor = primitive
         .get(&gltf::Semantic::TexCoords(set))
         .ok_or_else(|| format!("its material's base-colour texture uses TEXCOORD_{set}, which it does not have"))?;
@@ -383,7 +377,7 @@ fn typed(
     accessor: &gltf::Accessor,
     dimensions: gltf::accessor::Dimensions,
     types: &[gltf::accessor::DataType],
-) -> std::result::Result<(), String> {
+) -> Result<(), String> {
     let (d, t) = (accessor.dimensions(), accessor.data_type());
     if d != dimensions || !types.contains(&t) {
         return Err(format!(
@@ -398,7 +392,7 @@ fn typed(
 /// Whether an accessor's bytes lie inside its buffer view and the view
 /// inside its buffer, and its view's stride holds an element (the crate's
 /// reader assumes so, and panics on a shorter stride).
-fn fits(accessor: &gltf::Accessor, buffers: &[Vec<u8>]) -> std::result::Result<(), String> {
+fn fits(accessor: &gltf::Accessor, buffers: &[Vec<u8>]) -> Result<(), String> {
     if accessor.sparse().is_some() {
         return Err("sparse accessors are not read".into());
     }
@@ -440,7 +434,7 @@ fn node_axis(world: Affine3A, axis: Vec3) -> Option<Vec3> {
 /// The triangles the scene's nodes place, a mesh counted each time a node
 /// places it; refuses a hierarchy deeper than [`MAX_DEPTH`] or placing
 /// more than [`MAX_PLACED_NODES`] nodes, before anything is read.
-fn placed_triangles(scene: &gltf::Scene) -> std::result::Result<u64, String> {
+fn placed_triangles(scene: &gltf::Scene) -> Result<u64, String> {
     let mut stack: Vec<(gltf::Node, usize)> = scene.nodes().map(|n| (n, 0)).collect();
     let (mut placed, mut triangles) = (0u64, 0u64);
     while let Some((node, depth)) = stack.pop() {
@@ -469,14 +463,14 @@ fn placed_triangles(scene: &gltf::Scene) -> std::result::Result<u64, String> {
 /// [`LUMINOUS_EFFICACY`]. A spot's outer cone is Airlight's `cone_angle`,
 /// its inner one `falloff_start`, with the smoothstep profile between.
 /// `range` is not used: lights fall off by the inverse-square law.
-fn gltf_light(light: &gltf::khr_lights_punctual::Light, world: Affine3A) -> std::result::Result<Light, String> {
+fn gltf_light(light: &gltf::khr_lights_punctual::Light, world: Affine3A) -> Result<Light, String> {
     let power = Vec3::from_array(light.color()) * (light.intensity() / LUMINOUS_EFFICACY);
     if !(power.is_finite() && power.min_element() >= 0.0) {
         return Err(format!("a light's colour × intensity is not finite and ≥ 0: {power}"));
     }
     let position = world.transform_point3(Vec3::ZERO);
-    if !position.is_finite() || position.abs().max_element() > super::limits::MAX_COORDINATE {
-        return Err(super::limits::too_far(&format!("a light at {position}"), position.abs().max_element()));
+    if !position.is_finite() || position.abs().max_element() > limits::MAX_COORDINATE {
+        return Err(limits::too_far(&format!("a light at {position}"), position.abs().max_element()));
     }
     let direction = node_axis(world, Vec3::NEG_Z).ok_or("a light's node has no direction")?;
     use gltf::khr_lights_punctual::Kind;
@@ -511,10 +505,10 @@ fn gltf_light(light: &gltf::khr_lights_punctual::Light, world: Affine3A) -> std:
 
 /// A camera placed by its node: it looks along −Z with +Y up; `yfov` is
 /// Airlight's vertical `fov`, twice `ymag` its orthographic `view_height`.
-fn gltf_camera(camera: &gltf::Camera, world: Affine3A) -> std::result::Result<(Camera, Option<f32>), String> {
+fn gltf_camera(camera: &gltf::Camera, world: Affine3A) -> Result<(Camera, Option<f32>), String> {
     let position = world.transform_point3(Vec3::ZERO);
-    if !position.is_finite() || position.abs().max_element() > super::limits::MAX_COORDINATE {
-        return Err(super::limits::too_far(&format!("the camera at {position}"), position.abs().max_element()));
+    if !position.is_finite() || position.abs().max_element() > limits::MAX_COORDINATE {
+        return Err(limits::too_far(&format!("the camera at {position}"), position.abs().max_element()));
     }
     let forward = node_axis(world, Vec3::NEG_Z).ok_or("the camera's node has no direction")?;
     let up = node_axis(world, Vec3::Y).ok_or("the camera's node has no up direction")?;

@@ -10,7 +10,7 @@
 //! The tables are read from the spanned document (`toml::de::DeTable`),
 //! so that nested values keep their place in the text.
 
-use super::build::{Checker, Result};
+use super::check::{Checker, Result};
 use crate::options::{nearest, one_of};
 use serde::de::{self, DeserializeOwned, Visitor};
 use serde::{Deserialize, Deserializer};
@@ -104,7 +104,7 @@ macro_rules! tagged {
             $($(#[$vmeta])* $variant($ty),)+
         }
 
-        impl $crate::scene::tables::Tagged for $name {
+        impl $crate::scene_file::tables::Tagged for $name {
             const TAG: &'static str = $tag;
             const FAMILY: (&'static str, &'static str) = $family;
             const DEFAULT: Option<&'static str> = $default;
@@ -113,7 +113,7 @@ macro_rules! tagged {
 
             fn keys(name: &str) -> &'static [&'static str] {
                 match name {
-                    $($kind => $crate::scene::tables::keys_of::<$ty>(),)+
+                    $($kind => $crate::scene_file::tables::keys_of::<$ty>(),)+
                     _ => &[],
                 }
             }

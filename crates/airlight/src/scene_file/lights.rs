@@ -1,10 +1,10 @@
 //! The `[[lights]]` tables of a scene file, and their keyframes: each
 //! value checked, placed at its line, before a light is made.
 
-use super::build::{Checker, Result};
+use super::check::{Checker, Result};
 use super::desc::*;
-use super::limits;
 use crate::light::{Attenuation, Keyframes, Light, SpotProfile};
+use crate::scene::limits;
 use glam::Vec3;
 use std::ops::Range;
 

@@ -2,11 +2,11 @@
 //! camera it makes frames an image in f32 (positions within range, the
 //! view direction and up made and compared in f64).
 
-use super::build::{Checker, Result};
-use super::default_camera;
+use super::check::{Checker, Result};
 use super::desc::*;
-use super::limits;
 use crate::camera::{Camera, Projection};
+use crate::scene::default_camera;
+use crate::scene::limits;
 use glam::Vec3;
 
 impl Checker<'_> {
@@ -77,14 +77,14 @@ impl Checker<'_> {
         let focus = self.positive(span.clone(), "camera.focus_distance", focus)?;
         // Beyond the scene's reach a focus is at infinity; far beyond it its
         // square overflows f32 and every lens ray is lost.
-        if focus > super::limits::MAX_COORDINATE {
+        if focus > limits::MAX_COORDINATE {
             return Err(self.err_field(
                 span,
                 "focus_distance",
                 format!(
                     "camera.focus_distance must be at most {:e}, the scene's reach (a focus that far is at \
                      infinity), got {focus:e}",
-                    super::limits::MAX_COORDINATE
+                    limits::MAX_COORDINATE
                 ),
             ));
         }

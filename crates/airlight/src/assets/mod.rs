@@ -1,6 +1,10 @@
-//! Where the files a scene names (a mesh's `file`) may come from: the
-//! scene file's folder, then the asset folders the user names
-//! (`AIRLIGHT_ASSET_PATH` for the `airlight` command), and nowhere else.
+//! The files a scene names and their readers: OBJ meshes with their MTL
+//! materials, glTF scenes, images, Mitsuba `.vol` density grids; and the
+//! rules for where they may come from.
+//!
+//! A scene's files come from the scene file's folder, then the asset
+//! folders the user names (`AIRLIGHT_ASSET_PATH` for the `airlight`
+//! command), and nowhere else.
 //!
 //! A name must be a relative path without `..`; it is looked up in each
 //! folder in turn, and the file found must lie inside that folder once
@@ -9,6 +13,19 @@
 //! what exists elsewhere on the machine: a scene author cannot probe the
 //! rendering machine's files (`../../etc/passwd`, `/proc/self/environ`).
 
+mod gltf;
+mod images;
+mod loader;
+mod mesh;
+pub mod mtl;
+pub mod obj;
+pub mod vol;
+
+pub(crate) use gltf::{GltfInclude, Imported};
+pub use loader::Loader;
+pub(crate) use mesh::MeshPart;
+
+use crate::scene::SceneError;
 use std::io::Read;
 use std::path::{Component, Path, PathBuf};
 
@@ -117,13 +134,12 @@ pub fn read_limited(path: &Path, limit: u64) -> Result<Vec<u8>, String> {
 
 /// [`read_limited`] as UTF-8 text; an error is placed at the first byte
 /// that is not UTF-8 (the caller adds the file).
-pub fn read_text(path: &Path, limit: u64, what: &str) -> Result<String, super::SceneError> {
-    let bytes =
-        read_limited(path, limit).map_err(|e| super::SceneError::new(format!("cannot read the {what}: {e}")))?;
+pub fn read_text(path: &Path, limit: u64, what: &str) -> Result<String, SceneError> {
+    let bytes = read_limited(path, limit).map_err(|e| SceneError::new(format!("cannot read the {what}: {e}")))?;
     String::from_utf8(bytes).map_err(|e| {
         let at = e.utf8_error().valid_up_to();
         let text = String::from_utf8_lossy(&e.as_bytes()[..at]);
-        super::SceneError::at(&text, at, "not UTF-8 text")
+        SceneError::at(&text, at, "not UTF-8 text")
     })
 }
 

@@ -1,8 +1,8 @@
 //! The scene file as written: serde structs for the format that
 //! docs/scene-format.md describes, one per type of light, object, material,
 //! medium and SDF node (their fields are the type's keys; see
-//! [`super::tables`]). Unknown keys are errors. `build.rs` checks the
-//! values and turns them into a [`Scene`](super::Scene).
+//! [`super::tables`]). Unknown keys are errors. `check.rs` checks the
+//! values and turns them into a [`Scene`](crate::Scene).
 
 use super::tables::{NoShared, TableAt, Tagged, tagged};
 use crate::light::{AttenuationModel, SpotProfile};
@@ -50,7 +50,7 @@ pub struct IncludeDesc {
 
 /// The `[render]` table as written: each key with its value, both with
 /// their place in the text. Its keys are the film settings
-/// ([`super::RENDER_SETTINGS`]) and the integrators' options
+/// ([`crate::scene::RENDER_SETTINGS`]) and the integrators' options
 /// (`crate::integrator::INTEGRATOR_OPTIONS`); each is checked by its own
 /// declaration when read, and a key that neither reads is an error
 /// (`crate::SceneFile`).

@@ -1,44 +1,10 @@
-//! The `[materials.NAME]` tables of a scene file, checked and built; and a
-//! medium given as one line of `[medium]`'s keys (the command line's
-//! `--medium`), checked as the table is (build_medium.rs).
+//! The `[materials.NAME]` tables of a scene file, checked and built.
 
-use super::assets::AssetPath;
-use super::build::{Checker, Result, parse};
+use super::check::{Checker, Result};
 use super::desc::{self, MaterialDesc, Triple};
-use super::{SceneDesc, SceneError};
 use crate::Rgb;
 use crate::material::Material;
-use crate::medium::Medium;
 use glam::Vec3;
-use std::cell::{Cell, RefCell};
-
-/// A medium from the keys of a scene file's `[medium]` table written as
-/// one line, `key = value` pairs separated by commas (`sigma_s = 0.05,
-/// sigma_a = 0.01, g = 0.3`; colours as `[r, g, b]`; `type = "height"`),
-/// checked by the same rules as the table. For command lines, which give
-/// a medium without a scene file; a message without a line number. A
-/// grid's `file` is any file the user can read, absolute or relative to
-/// the working directory ([`AssetPath::CommandLine`]).
-pub fn medium_from_options(options: &str) -> Result<Medium, String> {
-    let text = format!("medium = {{ {options} }}");
-    let strip = |e: SceneError| e.message;
-    let desc: SceneDesc = parse(&text).map_err(strip)?;
-    if desc.medium.is_none() {
-        return Err("no medium".into());
-    }
-    let assets = AssetPath::CommandLine;
-    let document = toml::de::DeTable::parse(&text).map_err(|e| e.message().to_string())?.into_inner();
-    let checker = Checker {
-        text: &text,
-        assets: &assets,
-        document,
-        files: RefCell::default(),
-        mesh_bytes: Cell::new(0),
-        notes: RefCell::default(),
-        textures: RefCell::default(),
-    };
-    checker.medium().map_err(strip)
-}
 
 impl Checker<'_> {
     /// The material `[materials.NAME]` describes, read by its type.
@@ -64,6 +30,7 @@ impl Checker<'_> {
             MaterialDesc::Texture(m) => {
                 let factor = albedo(m.albedo, "albedo", 1.0)?;
                 let texture = self
+                    .loader
                     .texture_file(m.file.get_ref())
                     .map_err(|why| self.err(m.file.span(), format!("{label}.file: cannot load the texture: {why}")))?;
                 let texture = match &m.wrap {
