@@ -89,7 +89,7 @@ pub fn gi(args: GiArgs) -> Result<(), String> {
                 let out = dir.join(format!("frame_{k:04}.png"));
                 let s = scene.settings();
                 image
-                    .save_with(&out, s.exposure, s.tonemap)
+                    .save_with(&out, s.film.exposure, s.film.tonemap)
                     .map_err(|e| format!("cannot write `{}`: {e}", out.display()))?;
             }
         }

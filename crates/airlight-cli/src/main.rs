@@ -129,7 +129,7 @@ fn info(path: &Path) -> Result<(), String> {
     preflight::warn_if_dark(&scene, integrator.kind != IntegratorKind::Direct);
     let s = scene.settings();
     println!("scene: {}", path.display());
-    println!("image: {}×{}, {} spp, integrator {}", s.width, s.height, s.spp, integrator.kind);
+    println!("image: {}×{}, {} spp, integrator {}", s.film.width, s.film.height, s.spp, integrator.kind);
     if integrator.kind == IntegratorKind::Stochastic {
         let o = integrator.stochastic;
         println!("sampling: {}, {}", o.sampling, if o.stratify { "stratified" } else { "independent" });

@@ -18,7 +18,7 @@ pub const MAX_THREADS: u32 = airlight::render::MAX_THREADS;
 
 /// Refuses a render whose image and sums would not fit in memory.
 pub fn render_memory(scene: &Scene, mode: RenderMode) -> Result<(), String> {
-    mode.check_memory(scene.settings()).map_err(|e| format!("{e}: make the image smaller (--width, --height)"))
+    mode.check_memory(&scene.settings().film).map_err(|e| format!("{e}: make the image smaller (--width, --height)"))
 }
 
 /// Prints a warning when every frame of `scene` will be black, and one for
@@ -64,11 +64,12 @@ pub fn probe(scene: &Scene, integrator: &dyn Integrator, threads: usize, frames:
     let s = scene.settings();
     let start = Instant::now();
     for i in 0..PROBE * PROBE {
-        let (x, y) = ((2 * (i % PROBE) + 1) * s.width / (2 * PROBE), (2 * (i / PROBE) + 1) * s.height / (2 * PROBE));
+        let (x, y) =
+            ((2 * (i % PROBE) + 1) * s.film.width / (2 * PROBE), (2 * (i / PROBE) + 1) * s.film.height / (2 * PROBE));
         airlight::render::pixel_sum(scene, integrator, x, y, 0..1);
     }
     let per_sample = start.elapsed().as_secs_f64() / (PROBE * PROBE) as f64;
-    let samples = s.width as f64 * s.height as f64 * s.spp as f64 * frames as f64;
+    let samples = s.film.width as f64 * s.film.height as f64 * s.spp as f64 * frames as f64;
     let projected = per_sample * samples / threads.max(1) as f64;
     (projected > Forecast::LONG.as_secs_f64()).then(|| {
         format!(

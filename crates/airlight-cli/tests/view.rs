@@ -134,7 +134,7 @@ fn a_light_moved_toward_a_wall_brightens_it_and_leaves_the_other_room_unchanged(
     assert_eq!((first.width, first.height), SIZE);
 
     let mut scene = airlight::SceneFile::from_toml_str(TWO_ROOMS, None).unwrap().scene;
-    (scene.settings_mut().width, scene.settings_mut().height) = SIZE;
+    (scene.settings_mut().film.width, scene.settings_mut().film.height) = SIZE;
     // 0: the wall the light nears; 1: the other room, but for a strip along
     // the dividing wall as wide as the radiosity lookup's kernel (1.5 patch
     // sizes): shading there averages patches from both sides of the wall,

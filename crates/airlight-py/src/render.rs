@@ -82,7 +82,7 @@ impl State {
 pub fn run(py: Python<'_>, job: Job, progress: Option<Progress>) -> PyResult<Output> {
     let s = &job.settings;
     let samples = &job.render.samples;
-    let total = s.width as u64 * s.height as u64 * (samples.end - samples.start);
+    let total = s.film.pixels() * (samples.end - samples.start);
     let mut progress = progress.map(|p| Reporter::start(py, p, total)).transpose()?;
     let state = Arc::new(State::default());
     let worker = Arc::clone(&state);
@@ -155,7 +155,7 @@ fn work(job: &Job, state: &State) -> Result<Output, Failure> {
     }
     let samples = &job.render.samples;
     let (color, variance) = if job.render.variance {
-        let rows = 0..job.settings.height;
+        let rows = 0..job.settings.film.height;
         let acc = pool.install(|| accumulate(&shared.scene, integrator, samples.clone(), rows, &observer));
         let variance = flat(acc.pixels().iter().map(|p| p.variance_of_mean().as_vec3()));
         (flat(acc.pixels().iter().map(PixelSum::mean)), Some(variance))

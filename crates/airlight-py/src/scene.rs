@@ -14,9 +14,9 @@ use crate::render::{self, Job, Output, Progress};
 use crate::shared::Shared;
 use airlight::SceneFile;
 use airlight::aov::Aov;
+use airlight::assets::AssetPath;
 use airlight::integrator::{IntegratorDesc, IntegratorKind};
 use airlight::render::{MAX_THREADS, RenderRequest};
-use airlight::assets::AssetPath;
 use airlight::scene::RenderSettings;
 use numpy::ndarray::{Array2, Array3};
 use numpy::{PyArray2, PyArray3};
@@ -171,13 +171,13 @@ impl PyScene {
     /// Image width in pixels (the file's; `render(width=...)` overrides it).
     #[getter]
     fn width(&self) -> u32 {
-        self.settings.width
+        self.settings.film.width
     }
 
     /// Image height in pixels (the file's; `render(height=...)` overrides it).
     #[getter]
     fn height(&self) -> u32 {
-        self.settings.height
+        self.settings.film.height
     }
 
     /// Samples per pixel the file asks for.
@@ -228,8 +228,8 @@ impl PyScene {
         let time = self.time.map(|t| format!(", time {t}")).unwrap_or_default();
         format!(
             "<airlight.Scene {}×{}, {} spp, {}, {} lights{}{time}>",
-            s.width,
-            s.height,
+            s.film.width,
+            s.film.height,
             s.spp,
             self.integrator.kind,
             self.summary.lights,
@@ -349,7 +349,7 @@ impl PyScene {
             // As the CLI does before it renders: an image too large for
             // memory is refused, a scene that can only be black is warned of.
             job.mode
-                .check_memory(&settings)
+                .check_memory(&settings.film)
                 .map_err(|e| PyMemoryError::new_err(format!("{e}: make the image smaller (width=, height=)")))?;
             let sees_medium = desc.kind != IntegratorKind::Direct;
             if let Some(why) = &self.summary.darkness[sees_medium as usize] {
@@ -357,10 +357,15 @@ impl PyScene {
                 PyErr::warn(py, &py.get_type::<PyUserWarning>(), &message, 1)?;
             }
             let samples = &job.samples;
-            let label =
-                format!("{} {}×{} {} spp", desc.kind, settings.width, settings.height, samples.end - samples.start);
+            let label = format!(
+                "{} {}×{} {} spp",
+                desc.kind,
+                settings.film.width,
+                settings.film.height,
+                samples.end - samples.start
+            );
             let progress = Progress::from_arg(py, progress, &label)?;
-            let (w, h) = (settings.width, settings.height);
+            let (w, h) = (settings.film.width, settings.film.height);
             // A scene without keyframes is the same at every time.
             let pose = self.time.filter(|_| self.summary.animated);
             let shared = Arc::clone(&self.shared);

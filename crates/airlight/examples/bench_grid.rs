@@ -11,9 +11,9 @@
 //!     cargo run --release -p airlight --example bench_grid [-- N]
 
 use airlight::SceneFile;
+use airlight::assets::vol::{self, VolGrid};
 use airlight::film::compare;
 use airlight::integrator::{PathOptions, PathTracer};
-use airlight::assets::vol::{self, VolGrid};
 use airlight::medium::{DensityGrid, Medium};
 use airlight::prelude::*;
 use glam::Affine3A;

@@ -46,9 +46,9 @@ fn main() {
         |i: usize, default: u32| args.get(i).map_or(default, |s| s.parse().expect("SCENE PATH_SPP DEPTH8_SPP"));
     let (path_spp, depth8_spp, ref_spp) = (number(1, 256), number(2, 256), number(4, 65536));
     let mut scene = airlight::SceneFile::load(path.as_ref()).unwrap_or_else(|e| panic!("{e}")).scene;
-    let pixels = (scene.settings().width * scene.settings().height) as f64;
+    let pixels = (scene.settings().film.width * scene.settings().film.height) as f64;
     let one = rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap();
-    println!("{path}, {}×{}, one thread", scene.settings().width, scene.settings().height);
+    println!("{path}, {}×{}, one thread", scene.settings().film.width, scene.settings().film.height);
 
     scene.settings_mut().spp = 16;
     let t = Instant::now();

@@ -19,7 +19,7 @@ use std::time::Instant;
 fn main() {
     let path = std::env::args().nth(1).unwrap_or_else(|| "scenes/spheres_spot_fog.toml".into());
     let mut scene = airlight::SceneFile::load(path.as_ref()).unwrap_or_else(|e| panic!("{e}")).scene;
-    (scene.settings_mut().width, scene.settings_mut().height, scene.settings_mut().spp) = (640, 480, 1);
+    (scene.settings_mut().film.width, scene.settings_mut().film.height, scene.settings_mut().spp) = (640, 480, 1);
     let one = rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap();
     let traced = || one.broadcast(|_| shadow_rays_traced()).iter().sum::<u64>();
     println!("{path}, 640×480, 1 spp, one thread");
@@ -58,7 +58,7 @@ fn main() {
         rays.len() as f64 / secs / 1e6
     );
 
-    (scene.settings_mut().width, scene.settings_mut().height) = (320, 240);
+    (scene.settings_mut().film.width, scene.settings_mut().film.height) = (320, 240);
     let render =
         |steps, jitter| render(&scene, &Raymarch::new(RaymarchOptions { steps, jitter }), &RenderObserver::none());
     let reference = render(4096, false);

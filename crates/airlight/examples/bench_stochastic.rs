@@ -28,7 +28,7 @@ const SPPS: [u32; 6] = [1, 2, 4, 8, 16, 64];
 fn load(path: &str, (width, height): (u32, u32), spp: u32, seed: u64) -> (Scene, IntegratorDesc) {
     let SceneFile { mut scene, integrator } = SceneFile::load(path.as_ref()).unwrap_or_else(|e| panic!("{e}"));
     let s = scene.settings_mut();
-    (s.width, s.height, s.spp, s.seed) = (width, height, spp, seed);
+    (s.film.width, s.film.height, s.spp, s.seed) = (width, height, spp, seed);
     (scene, integrator)
 }
 

@@ -10,8 +10,8 @@
 //! in the scene): density 0.05 of haze below height 7, up to 4 in the
 //! cloud between heights 6 and 9, whose noise cuts gaps for the sun.
 
-use airlight::medium::NoiseFog;
 use airlight::assets::vol::{self, VolGrid};
+use airlight::medium::NoiseFog;
 use glam::Vec3;
 
 fn main() -> std::io::Result<()> {

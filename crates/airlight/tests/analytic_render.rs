@@ -37,7 +37,7 @@ fn analytic(scene: &Scene, shadows: bool, light_steps: u32, quadrature: LightQua
 /// same rays whatever the integrator, each with its own random stream; so
 /// two integrators' images differ only by what they compute along a ray.
 fn same_rays(scene: &Scene, integrator: &dyn Integrator, per_side: u32) -> Image {
-    let (w, h) = (scene.settings().width, scene.settings().height);
+    let (w, h) = (scene.settings().film.width, scene.settings().film.height);
     let rows: Vec<Vec<Rgb>> = (0..h)
         .into_par_iter()
         .map(|y| {
@@ -63,8 +63,8 @@ fn same_rays(scene: &Scene, integrator: &dyn Integrator, per_side: u32) -> Image
 }
 
 fn small(mut scene: Scene, w: u32, h: u32) -> Scene {
-    scene.settings_mut().width = w;
-    scene.settings_mut().height = h;
+    scene.settings_mut().film.width = w;
+    scene.settings_mut().film.height = h;
     scene.settings_mut().spp = 1;
     scene
 }
@@ -268,7 +268,7 @@ fn mesh_shadows_match_raymarch() {
 fn images_do_not_depend_on_the_thread_count() {
     let mut file = file("shadow_spheres.toml");
     let s = file.scene.settings_mut();
-    (s.width, s.height, s.spp) = (32, 24, 1);
+    (s.film.width, s.film.height, s.spp) = (32, 24, 1);
     let integrator = build(&file).unwrap();
     let scene = file.scene;
     let render = |threads: usize| {

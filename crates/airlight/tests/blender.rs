@@ -22,7 +22,7 @@ fn scenes() -> PathBuf {
 
 fn render(file: &mut SceneFile) -> Accumulator {
     let s = file.scene.settings_mut();
-    (s.width, s.height) = (WIDTH, HEIGHT);
+    (s.film.width, s.film.height) = (WIDTH, HEIGHT);
     let integrator = IntegratorDesc::new(IntegratorKind::Direct).build(&file.scene).unwrap();
     accumulate(&file.scene, integrator.as_ref(), 0..256, 0..HEIGHT, &Default::default())
 }
@@ -59,7 +59,7 @@ fn the_blender_export_renders_as_the_scene_written_by_hand() {
     assert!((intensity.x - 200.0 / (4.0 * std::f32::consts::PI)).abs() < 1e-3, "{intensity}");
     assert_eq!(exported.scene.lights().iter().filter(|l| matches!(l, Light::Triangle { .. })).count(), 2);
     let s = exported.scene.settings();
-    assert_eq!(s.height * 4, s.width * 3);
+    assert_eq!(s.film.height * 4, s.film.width * 3);
 
     let (a, b) = (render(&mut by_hand), render(&mut exported));
     // Blocks of 5×5 pixels: the floor's texture, the box, the lamp's

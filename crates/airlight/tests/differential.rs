@@ -35,6 +35,7 @@
 //! the seed. Cases it found are kept below as named tests.
 
 use airlight::film::Accumulator;
+use airlight::film::PixelFilter;
 use airlight::geometry::Shape;
 use airlight::integrator::{IntegratorDesc, IntegratorKind, RadiosityIntegrator, RadiosityOptions};
 use airlight::light::Light;
@@ -42,7 +43,6 @@ use airlight::material::Material;
 use airlight::medium::Medium;
 use airlight::prelude::*;
 use airlight::render::accumulate;
-use airlight::scene::PixelFilter;
 
 const DEFAULT_SCENES: u64 = 60;
 const SIZE: u32 = 6;
@@ -100,7 +100,7 @@ fn render_seed_override() -> Option<u64> {
 fn random_scene(seed: u64, render_seed: u64) -> Scene {
     let mut r = Rng(seed.wrapping_mul(0x2545_f491_4f6c_dd1d) ^ 0x1234_5678);
     let mut b = SceneBuilder::new().size(SIZE, SIZE).with_settings(|s| {
-        s.filter = PixelFilter::Point;
+        s.film.filter = PixelFilter::Point;
         s.max_distance = 40.0;
         s.seed = render_seed;
     });

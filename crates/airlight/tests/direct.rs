@@ -221,16 +221,17 @@ fn surfaces_see_an_area_light_at_a_slant_but_not_through_a_blocker() {
 /// one (`pixel_sum`) gives, bit for bit.
 fn batched_render_matches_samples_one_by_one(scene: &Scene, integrator: &dyn Integrator) {
     let s = scene.settings();
-    let acc = airlight::render::accumulate(scene, integrator, 0..s.spp as u64, 0..s.height, &RenderObserver::none());
+    let acc =
+        airlight::render::accumulate(scene, integrator, 0..s.spp as u64, 0..s.film.height, &RenderObserver::none());
     let mut lit = 0;
-    for y in 0..s.height {
-        for x in 0..s.width {
+    for y in 0..s.film.height {
+        for x in 0..s.film.width {
             let one_by_one = airlight::render::pixel_sum(scene, integrator, x, y, 0..s.spp as u64);
             assert_eq!(acc.pixel(x, y), Some(&one_by_one), "pixel ({x}, {y})");
             lit += (one_by_one.mean().max_element() > 0.0) as u32;
         }
     }
-    assert!(lit > s.width * s.height / 4, "{lit} lit pixels");
+    assert!(lit > s.film.width * s.film.height / 4, "{lit} lit pixels");
 }
 
 #[test]
@@ -244,8 +245,8 @@ fn packets_of_samples_give_the_one_by_one_image() {
     for name in ["gltf_lamp_room_fog.toml", "compare_cornell.toml"] {
         let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes").join(name);
         let mut scene = airlight::SceneFile::load(&path).expect("scene loads").scene;
-        scene.settings_mut().width = 61;
-        scene.settings_mut().height = 45;
+        scene.settings_mut().film.width = 61;
+        scene.settings_mut().film.height = 45;
         scene.settings_mut().spp = 2;
         batched_render_matches_samples_one_by_one(&scene, &Direct);
         batched_render_matches_samples_one_by_one(&scene, &path_tracer);

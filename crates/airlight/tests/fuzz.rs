@@ -216,7 +216,7 @@ fn scene_input(seed: u64, bases: &[toml::Table], dir: &Path) -> Result<bool, Str
     match SceneFile::load(&scene_path) {
         Ok(SceneFile { mut scene, integrator }) => {
             let s = scene.settings_mut();
-            (s.width, s.height, s.spp) = (3, 2, 1);
+            (s.film.width, s.film.height, s.spp) = (3, 2, 1);
             // Radiosity compiles its whole solution first: too slow here.
             if integrator.kind != IntegratorKind::Radiosity
                 && let Ok(built) = integrator.build(&scene)

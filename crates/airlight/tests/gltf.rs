@@ -143,7 +143,7 @@ fn a_gltf_room_renders_as_the_room_written_by_hand() {
     // `airlight render room.gltf`: the file alone is a scene; its camera's
     // aspect ratio sets the height.
     let direct = SceneFile::load(&path).unwrap();
-    assert_eq!(direct.scene.settings().height, direct.scene.settings().width);
+    assert_eq!(direct.scene.settings().film.height, direct.scene.settings().film.width);
     let lights = direct.scene.lights();
     assert_eq!(lights.iter().filter(|l| matches!(l, Light::Triangle { .. })).count(), 2);
     let Some(Light::Point { position, intensity, .. }) = lights.iter().find(|l| matches!(l, Light::Point { .. }))

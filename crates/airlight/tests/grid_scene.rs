@@ -3,8 +3,8 @@
 //! what is wrong; integrators that cannot render a grid say so.
 
 use airlight::SceneFile;
-use airlight::integrator::{IntegratorDesc, IntegratorKind};
 use airlight::assets::vol::{self, VolGrid};
+use airlight::integrator::{IntegratorDesc, IntegratorKind};
 use glam::Vec3;
 use std::path::Path;
 

@@ -3,9 +3,9 @@
 //! Each is refused with a message that names the real limit, or renders
 //! right; none panics.
 
+use airlight::assets::AssetPath;
 use airlight::film::Image;
 use airlight::prelude::*;
-use airlight::assets::AssetPath;
 use std::path::Path;
 
 const TAIL: &str = "[materials.m]\nalbedo = 0.5\n";

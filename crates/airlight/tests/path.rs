@@ -124,7 +124,7 @@ fn fog_scene(medium: Medium, spp: u32, seed: u64) -> Scene {
             s.spp = spp;
             s.seed = seed;
             s.max_distance = 12.0;
-            s.filter = airlight::scene::PixelFilter::Point;
+            s.film.filter = airlight::film::PixelFilter::Point;
         })
         .camera(Camera::look_at(vec3(0.0, 3.0, -6.0), vec3(0.0, 0.0, 1.0), Vec3::Y, 40.0))
         .material("floor", Material::diffuse(Rgb::splat(0.5)))

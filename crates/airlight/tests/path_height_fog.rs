@@ -144,7 +144,7 @@ fn extreme_height_fog_gives_finite_images() {
     ];
     for (medium, camera) in cases {
         let mut scene = open_fog(medium.clone(), Light::point(vec3(0.0, 0.5, 0.0), Rgb::splat(10.0)), camera, 16);
-        (scene.settings_mut().width, scene.settings_mut().height) = (8, 8);
+        (scene.settings_mut().film.width, scene.settings_mut().film.height) = (8, 8);
         let image = render_with(
             &scene,
             &PathTracer::new(PathOptions { max_depth: 8, ..PathOptions::default() }),

@@ -86,12 +86,12 @@ fn sliding_quad() -> Scene {
 fn pixel_of(scene: &Scene, p: Vec3) -> (u32, u32) {
     let s = scene.settings();
     let mut best = (f32::INFINITY, (0, 0));
-    for y in 0..s.height {
-        for x in 0..s.width {
+    for y in 0..s.film.height {
+        for x in 0..s.film.width {
             let ray = scene.camera().ray(
                 glam::Vec2::new(x as f32 + 0.5, y as f32 + 0.5),
-                s.width,
-                s.height,
+                s.film.width,
+                s.film.height,
                 glam::Vec2::splat(0.5),
             );
             let to = p - ray.origin;
@@ -135,7 +135,7 @@ fn frames_relight_radiosity_without_recompiling_and_match_a_fresh_compile() {
     let file = SceneFile::from_toml_str(include_str!("../../../scenes/room_moving_lights.toml"), None).unwrap();
     let SceneFile { mut scene, integrator: mut desc } = file;
     let s = scene.settings_mut();
-    (s.width, s.height, s.spp) = (24, 16, 1);
+    (s.film.width, s.film.height, s.spp) = (24, 16, 1);
     desc.radiosity.patch_size = Some(0.5);
     let compiled = Radiosity::compile_count();
     let mut integrator = desc.build(&scene).unwrap();

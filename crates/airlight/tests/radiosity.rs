@@ -127,7 +127,7 @@ fn radiosity_image_is_the_direct_image_plus_indirect_light() {
     let with_fog = |fog: &str| {
         let mut scene = SceneFile::from_toml_str(&format!("{CORNELL}\n{fog}"), None).unwrap().scene;
         let s = scene.settings_mut();
-        (s.width, s.height, s.spp) = (32, 32, 2);
+        (s.film.width, s.film.height, s.spp) = (32, 32, 2);
         scene
     };
     let scene = {
@@ -156,7 +156,7 @@ fn the_moving_lights_room_renders_a_frame() {
     // the bounce light adds to what the lights reach directly.
     let mut scene = SceneFile::from_toml_str(ROOM, None).unwrap().scene;
     let s = scene.settings_mut();
-    (s.width, s.height, s.spp) = (24, 16, 1);
+    (s.film.width, s.film.height, s.spp) = (24, 16, 1);
     let mut integrator = integrator(&scene, 0.5);
     let compiled = Radiosity::compile_count();
     airlight::render::set_time(&mut scene, &mut integrator, 0.5).unwrap();

@@ -13,7 +13,7 @@ fn every_example_scene_renders() {
         }
         let SceneFile { mut scene, mut integrator } = SceneFile::load(&path).unwrap_or_else(|e| panic!("{e}"));
         let s = scene.settings_mut();
-        (s.width, s.height, s.spp) = (40, 30, 1);
+        (s.film.width, s.film.height, s.spp) = (40, 30, 1);
         integrator.raymarch.steps = 16;
         let integrator = integrator.build(&scene).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
         let image = airlight::render(&scene, integrator.as_ref(), &RenderObserver::none());

@@ -96,7 +96,7 @@ fn the_isometric_scene_renders_its_fog() {
     assert_eq!(integrator.kind, IntegratorKind::Stochastic);
     assert!(matches!(scene.lights()[0], Light::Volume { shape: LightVolume::Box { .. }, .. }));
     let s = scene.settings_mut();
-    (s.width, s.height, s.spp) = (32, 24, 4);
+    (s.film.width, s.film.height, s.spp) = (32, 24, 4);
     let image = airlight::render(&scene, integrator.build(&scene).unwrap().as_ref(), &RenderObserver::none());
     // Every pixel sees the floor or a block through lit fog.
     assert!(image.pixels.iter().all(|p| p.min_element() > 0.0 && p.is_finite()));

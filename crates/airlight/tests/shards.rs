@@ -13,7 +13,7 @@ use airlight::render::{RenderObserver, accumulate, render};
 fn scene() -> SceneFile {
     let mut file = SceneFile::from_toml_str(include_str!("../../../scenes/spheres_spot_fog.toml"), None).unwrap();
     let s = file.scene.settings_mut();
-    (s.width, s.height, s.spp) = (20, 14, 7);
+    (s.film.width, s.film.height, s.spp) = (20, 14, 7);
     file.integrator.raymarch.steps = 16;
     file
 }
@@ -24,14 +24,14 @@ fn header(scene: &Scene, samples: std::ops::Range<u64>, rows: std::ops::Range<u3
         version: "test".into(),
         scene: "0".into(),
         seed: s.seed,
-        width: s.width,
-        height: s.height,
+        width: s.film.width,
+        height: s.film.height,
         spp: s.spp,
         samples,
         rows,
         frame: None,
-        exposure: s.exposure,
-        tonemap: s.tonemap,
+        exposure: s.film.exposure,
+        tonemap: s.film.tonemap,
     }
 }
 
@@ -39,7 +39,7 @@ fn header(scene: &Scene, samples: std::ops::Range<u64>, rows: std::ops::Range<u3
 fn any_split_into_shards_and_tiles_merges_to_the_single_render_bit_for_bit() {
     let file = scene();
     let scene = &file.scene;
-    let (spp, height) = (scene.settings().spp as u64, scene.settings().height as u64);
+    let (spp, height) = (scene.settings().spp as u64, scene.settings().film.height as u64);
     for kind in [IntegratorKind::Path, IntegratorKind::Stochastic, IntegratorKind::Raymarch] {
         let integrator = IntegratorDesc { kind, ..file.integrator }.build(scene).unwrap();
         let whole = render(scene, integrator.as_ref(), &RenderObserver::none());
@@ -72,7 +72,7 @@ fn parts_survive_their_files_exactly() {
     let mut parts = Vec::new();
     for k in 0..3 {
         let samples = piece(scene.settings().spp as u64, k, 3);
-        let rows = 0..scene.settings().height;
+        let rows = 0..scene.settings().film.height;
         let sums = accumulate(scene, integrator.as_ref(), samples.clone(), rows.clone(), &Default::default());
         let path = dir.path().join(format!("part{k}.exr"));
         Partial { header: header(scene, samples, rows), sums }.write(&path).unwrap();

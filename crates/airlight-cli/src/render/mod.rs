@@ -72,7 +72,7 @@ impl Plan {
     fn work(&self, scene: &Scene) -> u64 {
         let frames = self.frames.as_ref().map_or(1, |(list, _)| list.len() as u64);
         let rows = &self.job.rows;
-        let pixels = scene.settings().width as u64 * (rows.end - rows.start) as u64;
+        let pixels = scene.settings().film.width as u64 * (rows.end - rows.start) as u64;
         frames * pixels * (self.job.samples.end - self.job.samples.start)
     }
 }
@@ -154,14 +154,14 @@ pub fn render(args: RenderArgs) -> Result<(), String> {
             version: env!("CARGO_PKG_VERSION").into(),
             scene: fingerprint.clone(),
             seed: scene.settings().seed,
-            width: scene.settings().width,
-            height: scene.settings().height,
+            width: scene.settings().film.width,
+            height: scene.settings().film.height,
             spp: scene.settings().spp,
             samples: job.samples.clone(),
             rows: job.rows.clone(),
             frame,
-            exposure: scene.settings().exposure,
-            tonemap: scene.settings().tonemap,
+            exposure: scene.settings().film.exposure,
+            tonemap: scene.settings().film.tonemap,
         };
         let run =
             Run { scene: &scene, integrator: integrator.as_ref(), pool: &pool, progress: &progress, label: &label };
@@ -183,7 +183,7 @@ pub fn render(args: RenderArgs) -> Result<(), String> {
     progress.finish();
     if !args.quiet {
         let s = scene.settings();
-        let mut what = format!("{}×{}", s.width, s.height);
+        let mut what = format!("{}×{}", s.film.width, s.film.height);
         if let Some((list, n)) = &plan.frames {
             what = format!("{} of {n} frames of {what}", list.len());
         }
@@ -266,7 +266,7 @@ pub(crate) fn write_images(
     for out in &outputs.images {
         let written = match outputs.layers.channels(variance) {
             Some(channels) if crate::aovs::is_exr(out) => image.save_exr_with_channels(out, &channels),
-            _ => image.save_with(out, s.exposure, s.tonemap),
+            _ => image.save_with(out, s.film.exposure, s.film.tonemap),
         };
         written.map_err(|e| format!("cannot write `{}`: {e}", out.display()))?;
     }
@@ -288,7 +288,7 @@ pub(crate) struct Run<'a> {
 fn render_once(run: &Run, outputs: &FrameOutputs, timing: &mut Timing) -> Result<String, String> {
     let Run { scene, integrator, pool, progress, label } = *run;
     let s = scene.settings();
-    progress.set_message(format!("{label} {}×{} {} spp", s.width, s.height, s.spp));
+    progress.set_message(format!("{label} {}×{} {} spp", s.film.width, s.film.height, s.spp));
     let inc = |n: u64| progress.inc(n);
     let observer = RenderObserver { progress: Some(&inc), cancel: None };
     let image = timing.image(|| pool.install(|| airlight::render(scene, integrator, &observer)));
@@ -315,7 +315,7 @@ fn render_partial(run: &Run, output: &Path, header: PartialHeader, timing: &mut 
 fn describe(scene: &Scene, frames: Option<u32>) -> String {
     let s = scene.settings();
     let frames = frames.map(|n| format!("{n} frames of ")).unwrap_or_default();
-    format!("this render ({frames}{}×{} at {} spp)", s.width, s.height, s.spp)
+    format!("this render ({frames}{}×{} at {} spp)", s.film.width, s.film.height, s.spp)
 }
 
 pub(crate) fn format_error(error: f64) -> String {

@@ -92,8 +92,8 @@ pub(crate) fn render_progressive(
         error = progressive.estimated_relative_error();
         progress.set_message(format!(
             "{label} {}×{} {}/{} spp, est. error {}",
-            s.width,
-            s.height,
+            s.film.width,
+            s.film.height,
             progressive.samples(),
             s.spp,
             format_error(error),
@@ -121,7 +121,7 @@ pub(crate) fn render_progressive(
     }
     let _ = std::fs::remove_file(&state.path);
     // Samples skipped by reaching the target still count toward the bar.
-    let skipped = (s.spp - progressive.samples()) as u64 * s.width as u64 * s.height as u64;
+    let skipped = (s.spp - progressive.samples()) as u64 * s.film.pixels();
     progress.inc(skipped);
     Ok(format!("{} spp, estimated relative error {}", progressive.samples(), format_error(error)))
 }

@@ -77,8 +77,8 @@ const TRUTH_SEEDS: [u64; 2] = [0x7275_7468_0001, 0x7275_7468_0002];
 fn scene_file(args: &StudyArgs) -> Result<SceneFile, String> {
     let mut file = load(Some(&args.scene))?;
     let s = file.scene.settings_mut();
-    s.width = args.width.unwrap_or(s.width);
-    s.height = args.height.unwrap_or(s.height);
+    s.film.width = args.width.unwrap_or(s.film.width);
+    s.film.height = args.height.unwrap_or(s.film.height);
     s.seed = args.seed.unwrap_or(s.seed);
     s.spp = MAX_SPP;
     s.validate()?;
@@ -138,11 +138,11 @@ fn prepare_dir(dir: &Path, args: &StudyArgs, scene: &Scene) -> Result<(), String
 /// image of each of `series` series, a rung's image and error map).
 fn check_memory(scene: &Scene, series: usize) -> Result<(), String> {
     let s = scene.settings();
-    let pixels = s.width as u64 * s.height as u64;
+    let pixels = s.film.pixels();
     let image = pixels.saturating_mul(size_of::<airlight::Rgb>() as u64);
     let kept = (series as u64 + 4).saturating_mul(image);
     let needed = airlight::render::RenderMode::Progressive { cancellable: true }.bytes(pixels).saturating_add(kept);
-    airlight::memory::check(format!("a {}×{} study", s.width, s.height), needed)
+    airlight::memory::check(format!("a {}×{} study", s.film.width, s.film.height), needed)
         .map_err(|e| format!("{e}: make the image smaller (--width, --height)"))
 }
 
@@ -181,7 +181,9 @@ impl Context<'_> {
     fn save(&self, image: &Image, name: &str, scene: &Scene) -> Result<(), String> {
         let path = self.dir.join(name);
         let s = scene.settings();
-        image.save_with(&path, s.exposure, s.tonemap).map_err(|e| format!("cannot write `{}`: {e}", path.display()))
+        image
+            .save_with(&path, s.film.exposure, s.film.tonemap)
+            .map_err(|e| format!("cannot write `{}`: {e}", path.display()))
     }
 }
 
@@ -217,8 +219,8 @@ pub fn study(args: StudyArgs) -> Result<(), String> {
     let mut study = Study {
         scene: args.scene.display().to_string(),
         airlight_version: env!("CARGO_PKG_VERSION").into(),
-        width: s.width,
-        height: s.height,
+        width: s.film.width,
+        height: s.film.height,
         threads: ctx.pool.current_num_threads(),
         time_budget_seconds: args.time_budget,
         truth_error_target: args.truth_error,

@@ -151,7 +151,8 @@ fn probe(run: &Run) -> Option<f64> {
         if run.stop.load(Ordering::Relaxed) {
             return None;
         }
-        let (x, y) = ((2 * (i % PROBE) + 1) * s.width / (2 * PROBE), (2 * (i / PROBE) + 1) * s.height / (2 * PROBE));
+        let (x, y) =
+            ((2 * (i % PROBE) + 1) * s.film.width / (2 * PROBE), (2 * (i / PROBE) + 1) * s.film.height / (2 * PROBE));
         airlight::render::pixel_sum(run.scene, run.integrator, x, y, 0..1);
         samples += 1;
         if Instant::now() >= run.deadline {
@@ -159,7 +160,7 @@ fn probe(run: &Run) -> Option<f64> {
         }
     }
     let per_sample = start.elapsed().as_secs_f64() / samples as f64;
-    let pixels = s.width as f64 * s.height as f64;
+    let pixels = s.film.width as f64 * s.film.height as f64;
     Some(per_sample * pixels / run.pool.current_num_threads().max(1) as f64)
 }
 

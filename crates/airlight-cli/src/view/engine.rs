@@ -123,7 +123,7 @@ impl Engine {
     /// is still viewed, without indirect light; `solution_note` says why.
     pub fn new(file: SceneFile, width: u32, height: u32, mode: Mode) -> Engine {
         let SceneFile { mut scene, integrator: integrators } = file;
-        (scene.settings_mut().width, scene.settings_mut().height) = (width, height);
+        (scene.settings_mut().film.width, scene.settings_mut().film.height) = (width, height);
         let (solution, solution_note) = match Radiosity::compile(&scene, &integrators.radiosity) {
             Ok(s) => (Some(s), None),
             Err(e) => (None, Some(format!("no indirect light: {e}"))),
@@ -161,7 +161,7 @@ impl Engine {
 
     /// The size frames are rendered at now.
     pub fn size(&self) -> (u32, u32) {
-        (self.scene.settings().width, self.scene.settings().height)
+        (self.scene.settings().film.width, self.scene.settings().film.height)
     }
 
     pub fn full_size(&self) -> (u32, u32) {
@@ -204,8 +204,8 @@ impl Engine {
         if scale != self.scale {
             self.scale = scale;
             let s = self.scene.settings_mut();
-            s.width = (self.full.0 / scale).max(1);
-            s.height = (self.full.1 / scale).max(1);
+            s.film.width = (self.full.0 / scale).max(1);
+            s.film.height = (self.full.1 / scale).max(1);
             self.restart();
         }
     }
@@ -333,7 +333,7 @@ mod tests {
     fn reference(spp: u32) -> Scene {
         let mut scene = SceneFile::from_toml_str(super::super::DEFAULT_SCENE, None).unwrap().scene;
         let s = scene.settings_mut();
-        (s.width, s.height, s.spp) = (32, 18, spp);
+        (s.film.width, s.film.height, s.spp) = (32, 18, spp);
         scene
     }
 

@@ -49,7 +49,7 @@ pub fn run(engine: &mut Engine, script: &Script, start: &Start, frames: u32, out
             for ext in ["exr", "png"] {
                 let file = dir.join(format!("frame_{k:04}.{ext}"));
                 image
-                    .save_with(&file, settings.exposure, settings.tonemap)
+                    .save_with(&file, settings.film.exposure, settings.film.tonemap)
                     .map_err(|e| format!("cannot write `{}`: {e}", file.display()))?;
             }
         }

@@ -34,9 +34,9 @@
 
 use super::engine::Mode;
 use airlight::Camera;
+use airlight::assets::read_text;
 use airlight::camera::Projection;
 use airlight::light::{Keyframes, Light};
-use airlight::assets::read_text;
 use airlight::scene::limits::{MAX_COORDINATE, light_extent, too_far};
 use airlight::scene::{Scene, SceneError};
 use glam::Vec3;

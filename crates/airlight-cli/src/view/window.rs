@@ -43,7 +43,7 @@ pub fn run(engine: &mut Engine, start: &Start, options: &Options) -> Result<(), 
     let mut selected = 0;
     let (mut playing, mut time) = (false, 0.0f32);
     let mut buffer = vec![0u32; w * h];
-    let lut = Lut::new(engine.scene.settings().exposure, engine.scene.settings().tonemap);
+    let lut = Lut::new(engine.scene.settings().film.exposure, engine.scene.settings().film.tonemap);
     let mut last = Instant::now();
     let mut mouse_prev: Option<(f32, f32)> = None;
     let mut full_ms = 0.0;
@@ -187,7 +187,9 @@ fn save_image(image: &Image, engine: &Engine, dir: &Path) -> Result<String, Stri
     let stem = free.ok_or_else(|| format!("no free airlight-view-NNNN name left in `{}`", dir.display()))?;
     for ext in ["exr", "png"] {
         let file = stem.with_extension(ext);
-        image.save_with(&file, s.exposure, s.tonemap).map_err(|e| format!("cannot write `{}`: {e}", file.display()))?;
+        image
+            .save_with(&file, s.film.exposure, s.film.tonemap)
+            .map_err(|e| format!("cannot write `{}`: {e}", file.display()))?;
     }
     Ok(format!("{}.exr and .png", stem.display()))
 }

@@ -35,8 +35,8 @@ use std::time::Instant;
 fn load(name: &str, w: u32, h: u32) -> Scene {
     let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../scenes").join(name);
     let mut scene = airlight::SceneFile::load(&path).unwrap_or_else(|e| panic!("{e}")).scene;
-    scene.settings_mut().width = w;
-    scene.settings_mut().height = h;
+    scene.settings_mut().film.width = w;
+    scene.settings_mut().film.height = h;
     scene.settings_mut().spp = 1;
     scene
 }

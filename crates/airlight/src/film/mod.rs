@@ -7,11 +7,13 @@ mod accumulator;
 mod atomic;
 mod compare;
 pub mod partial;
+mod settings;
 
 pub use accumulator::{ACCUMULATOR_BYTES_PER_PIXEL, Accumulator, PixelSum, SQUARE_FRACTION_BITS, SUM_FRACTION_BITS};
 pub(crate) use accumulator::{AddSample, PixelTotal};
 pub use compare::{ImageError, compare, error_map};
 pub use partial::{Partial, PartialHeader};
+pub use settings::{FilmSettings, PixelFilter};
 
 use crate::Rgb;
 use std::io;

@@ -16,12 +16,13 @@ use super::Preview;
 use super::sparse::{Anchor, between_anchors};
 use crate::Rgb;
 use crate::film::Image;
+use crate::film::PixelFilter;
 use crate::geometry::{Geometry, GeometryBuilder, Hit, Ray, SurfaceHit};
 use crate::integrator::{DeferredShadows, through_medium};
 use crate::radiosity::Radiosity;
 use crate::render::PixelSample;
 use crate::sampling::Sampler;
-use crate::scene::{PixelFilter, Scene};
+use crate::scene::Scene;
 use crate::scratch::with_scratch;
 use crate::{Camera, CameraRays};
 use glam::{Vec2, Vec3};
@@ -152,7 +153,7 @@ impl FirstSample {
             self.fill(scene, solution);
         }
         let lights = light_surfaces(scene);
-        let (w, h) = (scene.settings().width, scene.settings().height);
+        let (w, h) = (scene.settings().film.width, scene.settings().film.height);
         let mut image = Image::new(w, h);
         image.pixels.par_chunks_mut(w.max(1) as usize).enumerate().for_each(|(y, row)| {
             let texels = &self.texels[y * row.len()..(y + 1) * row.len()];
@@ -171,11 +172,11 @@ impl FirstSample {
     fn fill(&mut self, scene: &Scene, solution: Option<&Radiosity>) {
         self.key = None;
         let s = scene.settings();
-        let (w, h) = (s.width as usize, s.height as usize);
+        let (w, h) = (s.film.width as usize, s.film.height as usize);
         self.texels.resize(w * h, Texel::empty());
         self.weights.resize_with(h, Vec::new);
         let objects = &self.objects;
-        let camera = scene.camera().rays(s.width, s.height);
+        let camera = scene.camera().rays(s.film.width, s.film.height);
         self.texels.par_chunks_mut(w.max(1)).zip(self.weights.par_iter_mut()).enumerate().for_each(
             |(y, (texels, weights))| {
                 with_scratch(&ROWS, |scratch| {
@@ -229,7 +230,7 @@ pub(super) fn trace_texels(
     out: &mut [Texel],
 ) {
     let s = scene.settings();
-    let (w, y) = (s.width as usize, span.y);
+    let (w, y) = (s.film.width as usize, span.y);
     let Tracing { films, lenses, rays, hits } = scratch;
     // The preview's camera numbers are not stratified: two independent
     // pairs, drawn from the generator the integrator then goes on with.
@@ -310,7 +311,7 @@ impl Rows<'_> {
         scratch: &mut Shading,
     ) {
         let Rows { scene, solution, preview, lights, weights, anchors } = *self;
-        let (w, h, y) = (row.len(), scene.settings().height as usize, span.y);
+        let (w, h, y) = (row.len(), scene.settings().film.height as usize, span.y);
         let Shading { samplers, shadows, radiance } = scratch;
         samplers.clear();
         shadows.clear();
@@ -416,7 +417,7 @@ fn own_weights(solution: &Radiosity, p: Vec3, n: Vec3, list: &mut Vec<(u32, f32)
 
 fn key(scene: &Scene) -> Key {
     let s = scene.settings();
-    (*scene.camera(), s.width, s.height, s.seed, s.filter)
+    (*scene.camera(), s.film.width, s.film.height, s.seed, s.film.filter)
 }
 
 /// The surfaces of the scene's area lights where they are now.
@@ -439,7 +440,7 @@ mod tests {
     const CORNELL: &str = include_str!("../../../../scenes/cornell_box.toml");
 
     fn check(scene: &mut Scene) {
-        (scene.settings_mut().width, scene.settings_mut().height) = (48, 27);
+        (scene.settings_mut().film.width, scene.settings_mut().film.height) = (48, 27);
         let options = RadiosityOptions::default();
         let mut solution = Radiosity::compile(scene, &options).unwrap();
         let mut cache = FirstSample::new(scene);

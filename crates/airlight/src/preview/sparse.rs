@@ -47,7 +47,7 @@ impl FirstSample {
         // they no longer serve this view.
         self.key = None;
         let lights = light_surfaces(scene);
-        let (w, h) = (scene.settings().width as usize, scene.settings().height as usize);
+        let (w, h) = (scene.settings().film.width as usize, scene.settings().film.height as usize);
         let camera = scene.camera().rays(w as u32, h as u32);
         let mut image = Image::new(w as u32, h as u32);
         if let Some(solution) = solution {
@@ -92,7 +92,7 @@ impl FirstSample {
         camera: &CameraRays,
         image: &mut Image,
     ) {
-        let (w, h) = (scene.settings().width as usize, scene.settings().height as usize);
+        let (w, h) = (scene.settings().film.width as usize, scene.settings().film.height as usize);
         let (columns, rows) = (w.div_ceil(2), h.div_ceil(2));
         self.anchors.resize(columns * rows, Anchor::default());
         let objects = &self.objects;
@@ -173,9 +173,9 @@ fn same_surface(p: Vec3, n: Vec3, q: Vec3, m: Vec3, radius: f32) -> bool {
 mod tests {
     use super::super::Fill;
     use super::*;
+    use crate::film::PixelFilter;
     use crate::integrator::{AnalyticOptions, RadiosityOptions, RaymarchOptions};
     use crate::render::{RenderObserver, render_samples};
-    use crate::scene::PixelFilter;
     use crate::{Camera, SceneFile};
     use glam::vec3;
 
@@ -186,7 +186,7 @@ mod tests {
     /// a sparse render against the exact one, whose anchors must be the
     /// same bits.
     fn sparse_against_exact(scene: &Scene, sparse: &Image, exact: &Image) -> (f32, f32, f32) {
-        let (w, h) = (scene.settings().width, scene.settings().height);
+        let (w, h) = (scene.settings().film.width, scene.settings().film.height);
         let (mut differ, mut worst, mut total_error, mut total) = (0, 0.0f32, 0.0f32, 0.0f32);
         for y in 0..h {
             for x in 0..w {
@@ -214,7 +214,7 @@ mod tests {
     #[test]
     fn a_sparse_fill_interpolates_the_indirect_light_closely_and_keeps_the_anchors_exact() {
         let mut scene = SceneFile::from_toml_str(CORNELL, None).unwrap().scene;
-        scene.settings_mut().filter = PixelFilter::Point;
+        scene.settings_mut().film.filter = PixelFilter::Point;
         let options = RadiosityOptions::default();
         let solution = Radiosity::compile(&scene, &options).unwrap();
         let own = *scene.camera();
@@ -232,7 +232,7 @@ mod tests {
         let views = [(corner, (192, 108), 0.05, 0.5), (own, (640, 360), 0.14, 0.15)];
         for (camera, (w, h), worst_allowed, blended) in views {
             scene.set_camera(camera);
-            (scene.settings_mut().width, scene.settings_mut().height) = (w, h);
+            (scene.settings_mut().film.width, scene.settings_mut().film.height) = (w, h);
             let preview = Preview::new(&scene, Some(&solution), AnalyticOptions::default(), RaymarchOptions::default());
             let exact = render_samples(&scene, &preview, 0, 1, &RenderObserver::none());
             let mut cache = FirstSample::new(&scene);
@@ -254,7 +254,7 @@ mod tests {
     #[test]
     fn a_sparse_fill_sees_the_light_where_the_exact_one_does() {
         let mut scene = SceneFile::from_toml_str(CORNELL, None).unwrap().scene;
-        (scene.settings_mut().width, scene.settings_mut().height) = (96, 96);
+        (scene.settings_mut().film.width, scene.settings_mut().film.height) = (96, 96);
         let options = RadiosityOptions::default();
         let solution = Radiosity::compile(&scene, &options).unwrap();
         let preview = Preview::new(&scene, Some(&solution), AnalyticOptions::default(), RaymarchOptions::default());

@@ -80,7 +80,7 @@ pub fn render_adaptive(scene: &Scene, integrator: &dyn Integrator, observer: &Re
     let mut sums = pilot(scene, integrator, observer);
     let first = pilot_samples(s.spp);
     let more = plan(&sums, s.spp - first, s.seed);
-    let width = s.width as usize;
+    let width = s.film.width as usize;
     // Each pixel goes on from the pilot's last sample.
     let samples_of = |x: u32, y: u32| first as u64..first as u64 + more[y as usize * width + x as usize] as u64;
     accumulate_pixel_samples(scene, integrator, s.seed, samples_of, &mut sums, observer);
@@ -90,7 +90,7 @@ pub fn render_adaptive(scene: &Scene, integrator: &dyn Integrator, observer: &Re
 /// Stage 1: samples 0 to [`pilot_samples`] of every pixel.
 pub fn pilot(scene: &Scene, integrator: &dyn Integrator, observer: &RenderObserver) -> Accumulator {
     let s = scene.settings();
-    let mut sums = Accumulator::new(s.width, s.height);
+    let mut sums = Accumulator::new(s.film.width, s.film.height);
     let pilot = pilot_samples(s.spp) as u64;
     // A pixel's count follows its neighbours' pilot noise; were their
     // pilot samples to share this pixel's paths, its count would follow

@@ -111,7 +111,7 @@ impl SurfaceAovs {
 /// stratified sequence, [`crate::integrator::Integrator::stratified`]).
 pub fn surface_aovs(scene: &Scene, stratified: bool, samples: Range<u64>) -> SurfaceAovs {
     let s = scene.settings();
-    let (width, height) = (s.width, s.height);
+    let (width, height) = (s.film.width, s.film.height);
     let pixels: Vec<(Rgb, Vec3, f32)> = (0..width as usize * height as usize)
         .into_par_iter()
         .map(|index| {
@@ -148,7 +148,7 @@ pub fn surface_aovs(scene: &Scene, stratified: bool, samples: Range<u64>) -> Sur
 /// ([`Integrator::radiance_parts`]).
 pub fn in_scattered_aov(scene: &Scene, integrator: &dyn Integrator, samples: Range<u64>) -> Option<Image> {
     let s = scene.settings();
-    let (width, height) = (s.width, s.height);
+    let (width, height) = (s.film.width, s.film.height);
     let stratified = integrator.stratified();
     let pixels: Option<Vec<Rgb>> = (0..width as usize * height as usize)
         .into_par_iter()
@@ -179,7 +179,7 @@ mod tests {
     /// quad light at the image's corner that is not its own albedo.
     fn scene() -> Scene {
         let mut settings = RenderSettings::default();
-        (settings.width, settings.height) = (8, 8);
+        (settings.film.width, settings.film.height) = (8, 8);
         SceneBuilder::new()
             .settings(settings)
             .camera(Camera::look_at(Vec3::new(0.0, 2.0, 0.0), Vec3::ZERO, Vec3::Z, 20.0))
@@ -215,7 +215,7 @@ mod tests {
     /// The floor scene in fog, or without the floor, or in vacuum.
     fn foggy(floor: bool, fog: bool) -> Scene {
         let mut settings = RenderSettings::default();
-        (settings.width, settings.height, settings.max_distance) = (6, 6, 8.0);
+        (settings.film.width, settings.film.height, settings.max_distance) = (6, 6, 8.0);
         let mut b = SceneBuilder::new()
             .settings(settings)
             .camera(Camera::look_at(Vec3::new(0.0, 2.0, -3.0), Vec3::ZERO, Vec3::Y, 50.0))

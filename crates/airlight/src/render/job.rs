@@ -7,6 +7,7 @@
 //! the rules are written once, here.
 
 use super::aov::Aov;
+use crate::film::FilmSettings;
 use crate::film::partial::piece;
 use crate::integrator::IntegratorKind;
 use crate::memory::MemoryError;
@@ -60,12 +61,11 @@ impl RenderMode {
         pixels.saturating_mul(per_pixel)
     }
 
-    /// Refuses a render of the settings' size in this mode that would not
-    /// fit in memory ([`crate::memory::check`]).
-    pub fn check_memory(self, settings: &RenderSettings) -> Result<(), MemoryError> {
-        let pixels = settings.width as u64 * settings.height as u64;
-        let what = format!("a {}×{} render", settings.width, settings.height);
-        crate::memory::check(what, self.bytes(pixels))
+    /// Refuses a render of the film's size in this mode that would not fit
+    /// in memory ([`crate::memory::check`]).
+    pub fn check_memory(self, film: &FilmSettings) -> Result<(), MemoryError> {
+        let what = format!("a {}×{} render", film.width, film.height);
+        crate::memory::check(what, self.bytes(film.pixels()))
     }
 }
 
@@ -121,7 +121,7 @@ impl RenderRequest {
             Some((k, n)) => Ok(piece(total, k as u64, n as u64)),
         };
         let samples = part("shard", self.shard, settings.spp as u64, "samples per pixel")?;
-        let rows = part("tile", self.tile, settings.height as u64, "rows")?;
+        let rows = part("tile", self.tile, settings.film.height as u64, "rows")?;
         let rows = rows.start as u32..rows.end as u32;
         let partial = self.shard.is_some() || self.tile.is_some();
         let variance = self.variance || self.aovs.contains(&Aov::Variance);
@@ -207,7 +207,9 @@ mod tests {
     use super::*;
 
     fn settings(spp: u32, adaptive: bool) -> RenderSettings {
-        RenderSettings { spp, adaptive, height: 10, ..RenderSettings::default() }
+        let mut s = RenderSettings { spp, adaptive, ..RenderSettings::default() };
+        s.film.height = 10;
+        s
     }
 
     #[test]

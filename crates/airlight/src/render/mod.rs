@@ -92,8 +92,8 @@ pub(crate) fn render_pixel_samples(
     observer: &RenderObserver,
 ) -> Image {
     let s = scene.settings();
-    let mut image = Image::new(s.width, s.height);
-    for_each_tile(&mut image.pixels, s.width, 0, observer, |origin, means| {
+    let mut image = Image::new(s.film.width, s.film.height);
+    for_each_tile(&mut image.pixels, s.film.width, 0, observer, |origin, means| {
         let tile_width = means.first().map_or(0, |row| row.len());
         let mut sums = vec![PixelTotal::default(); tile_width * means.len()];
         let mut sum_rows: TileRows<PixelTotal> = sums.chunks_mut(tile_width.max(1)).collect();
@@ -118,7 +118,7 @@ pub fn accumulate(
     rows: Range<u32>,
     observer: &RenderObserver,
 ) -> Accumulator {
-    let mut acc = Accumulator::band(scene.settings().width, scene.settings().height, rows);
+    let mut acc = Accumulator::band(scene.settings().film.width, scene.settings().film.height, rows);
     accumulate_into(scene, integrator, samples, &mut acc, observer);
     acc
 }
@@ -138,7 +138,7 @@ pub fn accumulate_into(
     let (width, height) = acc.size();
     assert_eq!(
         (width, height),
-        (scene.settings().width, scene.settings().height),
+        (scene.settings().film.width, scene.settings().film.height),
         "an accumulator of the scene's image"
     );
     accumulate_pixel_samples(scene, integrator, scene.settings().seed, |_, _| samples.clone(), acc, observer);
@@ -242,7 +242,7 @@ pub struct Progressive {
 impl Progressive {
     pub fn new(scene: &Scene) -> Self {
         let s = scene.settings();
-        Progressive { spp: s.spp, done: 0, accumulator: Accumulator::new(s.width, s.height) }
+        Progressive { spp: s.spp, done: 0, accumulator: Accumulator::new(s.film.width, s.film.height) }
     }
 
     /// Continues from an accumulator that holds the first `done` samples of
@@ -276,7 +276,7 @@ impl Progressive {
             return false;
         }
         let s = scene.settings();
-        if self.accumulator.size() != (s.width, s.height) || self.accumulator.rows() != (0..s.height) {
+        if self.accumulator.size() != (s.film.width, s.film.height) || self.accumulator.rows() != (0..s.film.height) {
             return false;
         }
         let first = self.done as u64;
@@ -286,7 +286,7 @@ impl Progressive {
             // without a second accumulator to fault in and merge.
             accumulate_into(scene, integrator, samples, &mut self.accumulator, observer);
         } else {
-            let pass = accumulate(scene, integrator, samples, 0..s.height, observer);
+            let pass = accumulate(scene, integrator, samples, 0..s.film.height, observer);
             if observer.cancelled() || self.accumulator.merge(&pass).is_err() {
                 return false;
             }

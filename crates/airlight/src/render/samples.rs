@@ -4,10 +4,11 @@
 //! into its pixel's sums.
 
 use crate::Rgb;
+use crate::film::PixelFilter;
 use crate::film::{AddSample, PixelSum};
 use crate::integrator::Integrator;
 use crate::sampling::Sampler;
-use crate::scene::{PixelFilter, RenderSettings, Scene};
+use crate::scene::{RenderSettings, Scene};
 use glam::Vec2;
 use std::ops::Range;
 
@@ -55,7 +56,7 @@ pub(super) fn tile_sums(
 ) -> u64 {
     let s = scene.settings();
     let (x1, y1) = (x0 + tile.first().map_or(0, |row| row.len() as u32), y0 + tile.len() as u32);
-    let film = scene.camera().rays(s.width, s.height);
+    let film = scene.camera().rays(s.film.width, s.film.height);
     let n = BLOCK_ORDER.len() * integrator.batch_blocks().max(1);
     let mut block = Vec::with_capacity(n);
     let mut batch = Batch::with_capacity(n);
@@ -172,7 +173,7 @@ pub struct PixelSample {
 
 impl PixelSample {
     pub fn new(settings: &RenderSettings, seed: u64, stratified: bool, x: u32, y: u32, i: u64) -> PixelSample {
-        let mut sampler = Sampler::for_pixel(seed, y as u64 * settings.width as u64 + x as u64, i);
+        let mut sampler = Sampler::for_pixel(seed, y as u64 * settings.film.width as u64 + x as u64, i);
         let (jitter, lens) = if stratified {
             let u = sampler.stratified4(0);
             (Vec2::new(u[0], u[1]), Vec2::new(u[2], u[3]))
@@ -180,7 +181,7 @@ impl PixelSample {
             (sampler.next2(), sampler.next2())
         };
         let film = Vec2::new(x as f32, y as f32)
-            + match settings.filter {
+            + match settings.film.filter {
                 PixelFilter::Box => jitter,
                 PixelFilter::Point => Vec2::splat(0.5),
             };
@@ -190,6 +191,6 @@ impl PixelSample {
     /// The sample's camera ray in `scene`.
     pub fn ray(&self, scene: &Scene) -> crate::geometry::Ray {
         let s = scene.settings();
-        scene.camera().rays(s.width, s.height).ray(self.film, self.lens)
+        scene.camera().rays(s.film.width, s.film.height).ray(self.film, self.lens)
     }
 }

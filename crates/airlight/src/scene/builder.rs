@@ -40,8 +40,8 @@ impl SceneBuilder {
     }
 
     pub fn size(mut self, width: u32, height: u32) -> Self {
-        self.settings.width = width;
-        self.settings.height = height;
+        self.settings.film.width = width;
+        self.settings.film.height = height;
         self
     }
 

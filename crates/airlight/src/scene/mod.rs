@@ -23,7 +23,7 @@ pub(crate) use builder::Parts;
 pub use builder::SceneBuilder;
 pub use culling::LightCulling;
 pub use error::{SceneError, line_col};
-pub use settings::{MAX_IMAGE_SIDE, MAX_PIXELS, MAX_SPP, PixelFilter, RENDER_SETTINGS, RenderSettings};
+pub use settings::{MAX_IMAGE_SIDE, MAX_PIXELS, MAX_SPP, RENDER_SETTINGS, RenderSettings};
 
 use crate::camera::Camera;
 use crate::geometry::{Geometry, GeometryBuilder, Shape, SurfaceHit};

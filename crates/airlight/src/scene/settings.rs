@@ -2,15 +2,15 @@
 //! not an integrator's), each declared once in [`RENDER_SETTINGS`].
 
 use crate::Rgb;
-use crate::film::Tonemap;
 use crate::options::{NumberRange, OptionSpec, OptionValue, ValueKind, set_named};
 
 /// The film and sampling settings of `[render]`: what every integrator
 /// shares. Integrators' own options live in [`crate::integrator`].
 #[derive(Clone, Debug, PartialEq)]
 pub struct RenderSettings {
-    pub width: u32,
-    pub height: u32,
+    /// The image: its size, how a pixel gathers its samples, and how it is
+    /// shown.
+    pub film: FilmSettings,
     /// Samples per pixel.
     pub spp: u32,
     pub seed: u64,
@@ -20,11 +20,6 @@ pub struct RenderSettings {
     pub max_distance: f32,
     /// Radiance of rays that escape.
     pub background: Rgb,
-    /// Stops, for PNG output only.
-    pub exposure: f32,
-    pub tonemap: Tonemap,
-    /// How a pixel gathers its samples.
-    pub filter: PixelFilter,
     /// Skip lights whose range ends before a point (finite-range falloffs).
     pub cull_lights: bool,
     /// Spread the samples over the pixels by their noise, `spp` a pixel on
@@ -32,6 +27,7 @@ pub struct RenderSettings {
     pub adaptive: bool,
 }
 
+use crate::film::FilmSettings;
 /// The image's limits are the film's.
 pub use crate::film::{MAX_IMAGE_SIDE, MAX_PIXELS};
 
@@ -43,58 +39,18 @@ impl RenderSettings {
     /// count; a message names the key and its bound.
     pub fn validate(&self) -> Result<(), String> {
         RENDER_SETTINGS.iter().try_for_each(|o| o.validate(self)).map_err(|e| e.message)?;
-        let (w, h) = (self.width, self.height);
-        if w as u64 * h as u64 > MAX_PIXELS {
-            return Err(format!("the image may have at most {MAX_PIXELS} pixels (16384²), got {w}×{h}"));
-        }
-        Ok(())
-    }
-}
-
-/// How the samples of a pixel are placed.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
-pub enum PixelFilter {
-    /// The mean over the pixel's square: samples jittered across it (anti-aliasing).
-    #[default]
-    Box,
-    /// Every sample through the pixel's centre: no anti-aliasing, but images
-    /// whose integrators take different sample counts share their camera rays.
-    Point,
-}
-
-impl PixelFilter {
-    /// The name a scene file gives it.
-    pub fn name(self) -> &'static str {
-        match self {
-            PixelFilter::Box => "box",
-            PixelFilter::Point => "point",
-        }
-    }
-}
-
-impl std::str::FromStr for PixelFilter {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
-        match s {
-            "box" => Ok(PixelFilter::Box),
-            "point" => Ok(PixelFilter::Point),
-            _ => Err(format!("unknown filter `{s}`; expected box or point")),
-        }
+        self.film.validate()
     }
 }
 
 impl Default for RenderSettings {
     fn default() -> Self {
         RenderSettings {
-            width: 640,
-            height: 480,
+            film: FilmSettings::default(),
             spp: 16,
             seed: 0,
             max_distance: 100.0,
             background: Rgb::ZERO,
-            exposure: 0.0,
-            tonemap: Tonemap::Clamp,
-            filter: PixelFilter::Box,
             cull_lights: true,
             adaptive: false,
         }
@@ -114,8 +70,8 @@ pub const RENDER_SETTINGS: &[OptionSpec<RenderSettings>] = &[
         unit: "pixels",
         doc: "Image width.",
         default_doc: None,
-        get: |s| OptionValue::Int(s.width as i128),
-        set: |s, v| s.width = v.count() as u32,
+        get: |s| OptionValue::Int(s.film.width as i128),
+        set: |s, v| s.film.width = v.count() as u32,
     },
     OptionSpec {
         key: "height",
@@ -123,8 +79,8 @@ pub const RENDER_SETTINGS: &[OptionSpec<RenderSettings>] = &[
         unit: "pixels",
         doc: "Image height (an included glTF camera's aspect ratio sets it when neither size is given).",
         default_doc: None,
-        get: |s| OptionValue::Int(s.height as i128),
-        set: |s, v| s.height = v.count() as u32,
+        get: |s| OptionValue::Int(s.film.height as i128),
+        set: |s, v| s.film.height = v.count() as u32,
     },
     OptionSpec {
         key: "spp",
@@ -168,8 +124,8 @@ pub const RENDER_SETTINGS: &[OptionSpec<RenderSettings>] = &[
         unit: "stops",
         doc: "Scales the image by 2^exposure before the tone curve (PNG output only).",
         default_doc: None,
-        get: |s| OptionValue::real(s.exposure),
-        set: |s, v| s.exposure = v.number() as f32,
+        get: |s| OptionValue::real(s.film.exposure),
+        set: |s, v| s.film.exposure = v.number() as f32,
     },
     OptionSpec {
         key: "tonemap",
@@ -177,8 +133,8 @@ pub const RENDER_SETTINGS: &[OptionSpec<RenderSettings>] = &[
         unit: "",
         doc: "Tone curve for PNG output: clip to [0, 1], or the ACES filmic fit (Narkowicz 2015).",
         default_doc: None,
-        get: |s| OptionValue::Text(s.tonemap.name().into()),
-        set: |s, v| set_named(&mut s.tonemap, v),
+        get: |s| OptionValue::Text(s.film.tonemap.name().into()),
+        set: |s, v| set_named(&mut s.film.tonemap, v),
     },
     OptionSpec {
         key: "filter",
@@ -186,8 +142,8 @@ pub const RENDER_SETTINGS: &[OptionSpec<RenderSettings>] = &[
         unit: "",
         doc: "Samples spread over each pixel's square (box), or all through its centre (point).",
         default_doc: None,
-        get: |s| OptionValue::Text(s.filter.name().into()),
-        set: |s, v| set_named(&mut s.filter, v),
+        get: |s| OptionValue::Text(s.film.filter.name().into()),
+        set: |s, v| set_named(&mut s.film.filter, v),
     },
     OptionSpec {
         key: "cull_lights",

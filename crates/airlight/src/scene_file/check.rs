@@ -97,7 +97,7 @@ impl Checker<'_> {
             && aspect.is_finite()
             && aspect > 0.0
         {
-            settings.height = ((settings.width as f32 / aspect).round() as u32).clamp(1, MAX_IMAGE_SIDE);
+            settings.film.height = ((settings.film.width as f32 / aspect).round() as u32).clamp(1, MAX_IMAGE_SIDE);
         }
         let mut builder = SceneBuilder::new().settings(settings);
         if let Some((camera, _)) = included_camera {

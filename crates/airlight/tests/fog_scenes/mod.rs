@@ -22,7 +22,7 @@ pub fn fog_scene(
             s.spp = spp;
             s.seed = seed;
             s.max_distance = max_distance;
-            s.filter = airlight::scene::PixelFilter::Point;
+            s.film.filter = airlight::film::PixelFilter::Point;
         })
         .camera(camera)
         .light(light)
@@ -35,7 +35,7 @@ pub fn fog_scene(
 /// pixel's mean, from the pixels' mean squared samples (s²/n, s² the
 /// unbiased variance).
 pub fn image_and_variance(scene: &Scene, integrator: &dyn Integrator) -> (Image, Vec<Rgb>) {
-    let (spp, height) = (scene.settings().spp, scene.settings().height);
+    let (spp, height) = (scene.settings().spp, scene.settings().film.height);
     let sums = accumulate(scene, integrator, 0..spp as u64, 0..height, &RenderObserver::none());
     (sums.image(), sums.variance().pixels)
 }
