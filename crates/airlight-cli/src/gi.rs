@@ -29,21 +29,22 @@ pub struct GiArgs {
 
 pub fn gi(args: GiArgs) -> Result<(), String> {
     use airlight::integrator::{Integrator, RadiosityIntegrator};
-    use airlight::render::{frame_time, render, set_time};
+    use airlight::render::{RenderRequest, frame_time, set_time};
     let SceneFile { mut scene, integrator: mut desc } = load::load(Some(&args.scene))?;
     let mut settings = scene.settings().clone();
     args.options.apply(&mut settings, &mut desc)?;
     *scene.settings_mut() = settings;
+    let job = RenderRequest { threads: args.threads, ..Default::default() }
+        .check(scene.settings(), IntegratorKind::Radiosity)?;
     if let Some(dir) = &args.output_dir {
         let names = (0..args.frames).map(|k| format!("frame_{k:04}.png"));
         let inputs: Vec<&std::path::Path> =
             std::iter::once(args.scene.as_path()).chain(scene.files().iter().map(PathBuf::as_path)).collect();
         outputs::check_in_folder("--output-dir", dir, names, &inputs)?;
-        let job = airlight::render::RenderRequest::default().check(scene.settings(), IntegratorKind::Radiosity)?;
         preflight::render_memory(&scene, job.mode)?;
     }
     preflight::warn_if_dark(&scene, true);
-    let pool = airlight::render::thread_pool(args.threads)?;
+    let pool = job.thread_pool()?;
     pool.install(|| {
         let mut integrator = RadiosityIntegrator::new(&scene, desc.radiosity, desc.raymarch)
             .map_err(|e| format!("{}: {e}", args.scene.display()))?;
@@ -85,7 +86,8 @@ pub fn gi(args: GiArgs) -> Result<(), String> {
             set_time(&mut scene, &mut integrator, frame_time(k, args.frames)).map_err(|e| e.to_string())?;
             frames.push(integrator.last_update);
             if let Some(dir) = &args.output_dir {
-                let image = render(&scene, &integrator as &dyn Integrator, &RenderObserver::none());
+                let image =
+                    job.run(&pool, &scene, &integrator as &dyn Integrator, &RenderObserver::none()).into_image();
                 let out = dir.join(format!("frame_{k:04}.png"));
                 let s = scene.settings();
                 image

@@ -25,6 +25,18 @@ impl Timing {
         out
     }
 
+    /// Runs `render`, whose writing (timed by the `Timing` it is given)
+    /// counts as writing and the rest as the image's: passes that write
+    /// their outputs between them.
+    pub fn image_writing<T>(&mut self, render: impl FnOnce(&mut Timing) -> T) -> T {
+        let start = Instant::now();
+        let mut inner = Timing::default();
+        let out = render(&mut inner);
+        self.writing += inner.writing;
+        self.image += start.elapsed().saturating_sub(inner.writing);
+        out
+    }
+
     /// Runs `write`, counting its time as writing outputs.
     pub fn writing<T>(&mut self, write: impl FnOnce() -> T) -> T {
         let start = Instant::now();

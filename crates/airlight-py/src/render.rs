@@ -9,7 +9,7 @@ use airlight::Rgb;
 use airlight::aov::{SurfaceAovs, surface_aovs};
 use airlight::film::PixelSum;
 use airlight::integrator::IntegratorDesc;
-use airlight::render::{RenderJob, RenderMode, RenderObserver, accumulate, render_samples};
+use airlight::render::{RenderJob, RenderObserver, Rendered};
 use airlight::scene::RenderSettings;
 use pyo3::exceptions::{PyImportError, PyRuntimeError};
 use pyo3::prelude::*;
@@ -148,26 +148,20 @@ fn work(job: &Job, state: &State) -> Result<Output, Failure> {
         state.done.fetch_add(n, Ordering::Relaxed);
     };
     let observer = RenderObserver { progress: Some(&count), cancel: Some(&state.cancel) };
-    // Built here, off the GIL, into the buffers the arrays will own. Only a
-    // variance needs every pixel's sums kept to the end.
+    // Built here, off the GIL, into the buffers the arrays will own.
     fn flat(pixels: impl Iterator<Item = Rgb>) -> Vec<f32> {
         pixels.flat_map(|p| p.to_array()).collect()
     }
     let samples = &job.render.samples;
-    let (color, variance) = if job.render.variance {
-        let rows = 0..job.settings.film.height;
-        let acc = pool.install(|| accumulate(&shared.scene, integrator, samples.clone(), rows, &observer));
-        let variance = flat(acc.pixels().iter().map(|p| p.variance_of_mean().as_vec3()));
-        (flat(acc.pixels().iter().map(PixelSum::mean)), Some(variance))
-    } else if job.render.mode == RenderMode::Adaptive {
-        // Every sample of the render (a shard is refused): spread by noise.
-        let image = pool.install(|| airlight::render(&shared.scene, integrator, &observer));
-        (flat(image.pixels.into_iter()), None)
-    } else {
-        // (At most the scene's spp, a u32.)
-        let (first, count) = (samples.start, (samples.end - samples.start) as u32);
-        let image = pool.install(|| render_samples(&shared.scene, integrator, first, count, &observer));
-        (flat(image.pixels.into_iter()), None)
+    // A variance needs every pixel's sums kept to the end, as does a shard
+    // (whose sums give its mean here).
+    let (color, variance) = match job.render.run(&pool, &shared.scene, integrator, &observer) {
+        Rendered::Image(image) => (flat(image.pixels.into_iter()), None),
+        Rendered::Sums(sums) => {
+            let variance =
+                job.render.variance.then(|| flat(sums.pixels().iter().map(|p| p.variance_of_mean().as_vec3())));
+            (flat(sums.pixels().iter().map(PixelSum::mean)), variance)
+        }
     };
     if state.cancel.load(Ordering::Relaxed) {
         return Err(Failure::Cancelled);

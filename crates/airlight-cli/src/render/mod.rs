@@ -16,7 +16,7 @@ use airlight::SceneFile;
 use airlight::film::Image;
 use airlight::film::partial::{Partial, PartialHeader};
 use airlight::integrator::{Integrator, IntegratorKind};
-use airlight::render::{RenderJob, RenderMode, RenderObserver, RenderRequest, accumulate, frame_time, set_time};
+use airlight::render::{RenderJob, RenderMode, RenderObserver, RenderRequest, Rendered, frame_time, set_time};
 use airlight::scene::Scene;
 use args::{configure, output_paths};
 use progressive::{State, render_progressive, state_path};
@@ -54,6 +54,7 @@ impl Plan {
             shard: args.shard,
             tile: args.tile,
             passes: args.progressive || args.target_error.is_some(),
+            cancellable: false,
             variance: args.variance.is_some(),
             aovs: args.aov.clone().map(|list| list.0).unwrap_or_default(),
             threads: args.threads,
@@ -163,8 +164,14 @@ pub fn render(args: RenderArgs) -> Result<(), String> {
             exposure: scene.settings().film.exposure,
             tonemap: scene.settings().film.tonemap,
         };
-        let run =
-            Run { scene: &scene, integrator: integrator.as_ref(), pool: &pool, progress: &progress, label: &label };
+        let run = Run {
+            job,
+            scene: &scene,
+            integrator: integrator.as_ref(),
+            pool: &pool,
+            progress: &progress,
+            label: &label,
+        };
         let summary = if job.partial() {
             render_partial(&run, &outputs.images[0], header, &mut timing)?
         } else if matches!(job.mode, RenderMode::Progressive { .. }) {
@@ -273,10 +280,11 @@ pub(crate) fn write_images(
     Ok(())
 }
 
-/// What renders one frame: the scene as it is at the frame, the
-/// integrator, the worker threads, the progress bar and the frame's label
-/// for it ("path frame 3 of 24").
+/// What renders one frame: the job, the scene as it is at the frame, the
+/// integrator, the job's worker threads, the progress bar and the frame's
+/// label for it ("path frame 3 of 24").
 pub(crate) struct Run<'a> {
+    pub job: &'a RenderJob,
     pub scene: &'a Scene,
     pub integrator: &'a dyn Integrator,
     pub pool: &'a rayon::ThreadPool,
@@ -286,12 +294,12 @@ pub(crate) struct Run<'a> {
 
 /// All samples in one go; returns nothing to report.
 fn render_once(run: &Run, outputs: &FrameOutputs, timing: &mut Timing) -> Result<String, String> {
-    let Run { scene, integrator, pool, progress, label } = *run;
+    let Run { job, scene, integrator, pool, progress, label } = *run;
     let s = scene.settings();
     progress.set_message(format!("{label} {}×{} {} spp", s.film.width, s.film.height, s.spp));
     let inc = |n: u64| progress.inc(n);
     let observer = RenderObserver { progress: Some(&inc), cancel: None };
-    let image = timing.image(|| pool.install(|| airlight::render(scene, integrator, &observer)));
+    let image = timing.image(|| job.run(pool, scene, integrator, &observer).into_image());
     timing.writing(|| write_images(scene, &image, outputs, None))?;
     Ok(String::new())
 }
@@ -299,12 +307,13 @@ fn render_once(run: &Run, outputs: &FrameOutputs, timing: &mut Timing) -> Result
 /// One part of a render (`header`'s samples of its rows), written as a
 /// partial EXR.
 fn render_partial(run: &Run, output: &Path, header: PartialHeader, timing: &mut Timing) -> Result<String, String> {
-    let Run { scene, integrator, pool, progress, label } = *run;
+    let Run { job, scene, integrator, pool, progress, label } = *run;
     progress.set_message(format!("{label} samples {:?} of rows {:?}", header.samples, header.rows));
     let inc = |n: u64| progress.inc(n);
     let observer = RenderObserver { progress: Some(&inc), cancel: None };
-    let (samples, rows) = (header.samples.clone(), header.rows.clone());
-    let sums = timing.image(|| pool.install(|| accumulate(scene, integrator, samples, rows, &observer)));
+    let Rendered::Sums(sums) = timing.image(|| job.run(pool, scene, integrator, &observer)) else {
+        return Err("a part of a render gives its sums".into());
+    };
     timing
         .writing(|| Partial { header, sums }.write(output))
         .map_err(|e| format!("cannot write `{}`: {e}", output.display()))?;

@@ -8,6 +8,7 @@ use crate::timing::Timing;
 use airlight::film::partial::{self, Partial, PartialHeader};
 use airlight::render::{Progressive, RenderObserver};
 use airlight::scene::Scene;
+use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
 
 /// Where a progressive render keeps its samples so far, and what they are.
@@ -76,20 +77,21 @@ pub(crate) fn render_progressive(
     state: &State,
     timing: &mut Timing,
 ) -> Result<String, String> {
-    let Run { scene, integrator, pool, progress, label } = *run;
+    let Run { job, scene, integrator, pool, progress, label } = *run;
     let s = scene.settings();
     let mut progressive = resumed(scene, state, outputs, progress)?;
-    let mut error = progressive.estimated_relative_error();
-    if progressive.samples() > 0 && (progressive.finished() || target_error.is_some_and(|target| error < target)) {
+    if progressive.samples() > 0
+        && (progressive.finished()
+            || target_error.is_some_and(|target| progressive.estimated_relative_error() < target))
+    {
         // Stopped after its last pass, before it tidied up: the images again.
         let variance = outputs.layers.wants_variance().then(|| progressive.variance());
         timing.writing(|| write_images(scene, &progressive.image(), outputs, variance.as_ref()))?;
     }
-    while !progressive.finished() && !target_error.is_some_and(|target| error < target) {
-        let inc = |n: u64| progress.inc(n);
-        let observer = RenderObserver { progress: Some(&inc), cancel: None };
-        timing.image(|| pool.install(|| progressive.pass(scene, integrator, &observer)));
-        error = progressive.estimated_relative_error();
+    let inc = |n: u64| progress.inc(n);
+    let observer = RenderObserver { progress: Some(&inc), cancel: None };
+    let after_pass = |progressive: &Progressive, timing: &mut Timing| -> Result<ControlFlow<()>, String> {
+        let error = progressive.estimated_relative_error();
         progress.set_message(format!(
             "{label} {}×{} {}/{} spp, est. error {}",
             s.film.width,
@@ -118,7 +120,12 @@ pub(crate) fn render_progressive(
             partial::write(&state.path, &header, progressive.accumulator())
                 .map_err(|e| format!("cannot write `{}`: {e}", state.path.display()))
         })?;
-    }
+        Ok(ControlFlow::Continue(()))
+    };
+    timing.image_writing(|timing| {
+        job.run_passes(pool, scene, integrator, &mut progressive, &observer, target_error, |p| after_pass(p, timing))
+    })?;
+    let error = progressive.estimated_relative_error();
     let _ = std::fs::remove_file(&state.path);
     // Samples skipped by reaching the target still count toward the bar.
     let skipped = (s.spp - progressive.samples()) as u64 * s.film.pixels();

@@ -24,6 +24,7 @@ use crate::progress::Progress;
 use airlight::SceneFile;
 use airlight::film::Image;
 use airlight::integrator::IntegratorKind;
+use airlight::render::{RenderJob, RenderRequest};
 use airlight::scene::{MAX_IMAGE_SIDE, MAX_SPP, Scene};
 use data::{State, Study};
 use std::path::{Path, PathBuf};
@@ -136,12 +137,12 @@ fn prepare_dir(dir: &Path, args: &StudyArgs, scene: &Scene) -> Result<(), String
 /// Refuses a study whose images would not fit in memory: a progressive
 /// render's, and the images it keeps beside it (the truths, the first
 /// image of each of `series` series, a rung's image and error map).
-fn check_memory(scene: &Scene, series: usize) -> Result<(), String> {
+fn check_memory(scene: &Scene, job: &RenderJob, series: usize) -> Result<(), String> {
     let s = scene.settings();
     let pixels = s.film.pixels();
     let image = pixels.saturating_mul(size_of::<airlight::Rgb>() as u64);
     let kept = (series as u64 + 4).saturating_mul(image);
-    let needed = airlight::render::RenderMode::Progressive { cancellable: true }.bytes(pixels).saturating_add(kept);
+    let needed = job.mode.bytes(pixels).saturating_add(kept);
     airlight::memory::check(format!("a {}×{} study", s.film.width, s.film.height), needed)
         .map_err(|e| format!("{e}: make the image smaller (--width, --height)"))
 }
@@ -150,6 +151,8 @@ fn check_memory(scene: &Scene, series: usize) -> Result<(), String> {
 struct Context<'a> {
     dir: &'a Path,
     json: Option<&'a Path>,
+    /// Every run's job: passes that a deadline may cancel.
+    job: RenderJob,
     pool: rayon::ThreadPool,
     stop: Arc<AtomicBool>,
     start: Instant,
@@ -193,10 +196,12 @@ pub fn study(args: StudyArgs) -> Result<(), String> {
     kinds.dedup();
     let stem = args.scene.file_stem().unwrap_or_default().to_string_lossy();
     let dir = args.output.clone().unwrap_or_else(|| PathBuf::from(format!("{stem}-study")));
-    check_memory(&scene, plan::ladder(&scene, &desc, &kinds).0.len())?;
+    let request = RenderRequest { cancellable: true, threads: args.threads, ..Default::default() };
+    let job = request.check(scene.settings(), desc.kind)?;
+    check_memory(&scene, &job, plan::ladder(&scene, &desc, &kinds).0.len())?;
     crate::preflight::warn_if_dark(&scene, true);
     prepare_dir(&dir, &args, &scene)?;
-    let pool = airlight::render::thread_pool(args.threads)?;
+    let pool = job.thread_pool()?;
     let stop = Arc::new(AtomicBool::new(false));
     for signal in [signal_hook::consts::SIGINT, signal_hook::consts::SIGTERM] {
         // A second Ctrl-C ends the study at once; the first stops it tidily.
@@ -208,6 +213,7 @@ pub fn study(args: StudyArgs) -> Result<(), String> {
     let ctx = Context {
         dir: &dir,
         json: args.json.as_deref(),
+        job,
         pool,
         stop,
         start,

@@ -5,8 +5,9 @@
 //! build plus all passes so far.
 
 use airlight::integrator::Integrator;
-use airlight::render::{Progressive, RenderObserver};
+use airlight::render::{PassesEnd, Progressive, RenderJob, RenderObserver};
 use airlight::scene::Scene;
+use std::ops::ControlFlow;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
@@ -47,6 +48,8 @@ impl Stop {
 pub struct Run<'a> {
     pub scene: &'a Scene,
     pub integrator: &'a dyn Integrator,
+    /// Passes that may be cancelled, and their threads (`pool`).
+    pub job: &'a RenderJob,
     pub pool: &'a rayon::ThreadPool,
     /// Set by Ctrl-C.
     pub stop: &'a AtomicBool,
@@ -72,68 +75,75 @@ pub type Rung<'a> = dyn FnMut(&Progressive, f64) -> Result<bool, String> + 'a;
 /// (not timed: writing images and the report is not the method's cost).
 pub fn passes(run: &Run, rung: &mut Rung) -> Result<Stop, String> {
     let mut progressive = Progressive::new(run.scene);
+    if progressive.finished() {
+        return Ok(Stop::Spp);
+    }
+    if run.stop.load(Ordering::Relaxed) {
+        return Ok(Stop::User);
+    }
+    if Instant::now() >= run.deadline {
+        return Ok(Stop::Deadline);
+    }
+    // A tile cannot be stopped half way, and one tile of a slow method may
+    // take minutes: a first pass that would end past the deadline is not
+    // started.
+    let Some(probed) = probe(run) else {
+        return Ok(Stop::User);
+    };
+    if Instant::now() + Duration::from_secs_f64(probed.min(1e9)) > run.deadline {
+        return Ok(Stop::Probe);
+    }
+    let cancel = AtomicBool::new(false);
+    let tile_done = |_: u64| {
+        if run.stop.load(Ordering::Relaxed) || Instant::now() >= run.deadline {
+            cancel.store(true, Ordering::Relaxed);
+        }
+        (run.tick)();
+    };
+    let observer = RenderObserver { progress: Some(&tile_done), cancel: Some(&cancel) };
     let mut seconds = run.built;
-    // Seconds per sample per pixel of the last pass.
-    let mut per_spp: Option<f64> = None;
-    let mut first = true;
-    loop {
-        if progressive.finished() {
-            return Ok(Stop::Spp);
-        }
-        if let Some(target) = run.target_error
-            && progressive.estimated_relative_error() < target
-        {
-            return Ok(Stop::Target);
-        }
-        if run.stop.load(Ordering::Relaxed) {
-            return Ok(Stop::User);
+    let mut stopped = None;
+    let mut size = progressive.next_pass_size();
+    let mut pass_start = Instant::now();
+    let after_pass = |p: &Progressive| -> Result<ControlFlow<()>, String> {
+        let took = pass_start.elapsed().as_secs_f64();
+        seconds += took;
+        // Seconds per sample per pixel of the pass just done.
+        let per_spp = took / size as f64;
+        if !rung(p, seconds)? {
+            stopped = Some(Stop::Caller);
+            return Ok(ControlFlow::Break(()));
         }
         let now = Instant::now();
-        if now >= run.deadline {
-            return Ok(Stop::Deadline);
-        }
-        if first {
-            // A tile cannot be stopped half way, and one tile of a slow
-            // method may take minutes: a first pass that would end past
-            // the deadline is not started.
-            let Some(probed) = probe(run) else {
-                return Ok(Stop::User);
-            };
-            if Instant::now() + Duration::from_secs_f64(probed.min(1e9)) > run.deadline {
-                return Ok(Stop::Probe);
-            }
-        } else if let Some(per_spp) = per_spp {
-            // Pass sizes double, so a pass costs about all before it.
-            let predicted = per_spp * progressive.next_pass_size() as f64;
-            if seconds + predicted > run.share {
-                return Ok(Stop::Share);
-            }
-            if now + Duration::from_secs_f64(predicted.min(1e9)) > run.deadline {
-                return Ok(Stop::Deadline);
-            }
-        }
-        first = false;
-        let cancel = AtomicBool::new(false);
-        let tile_done = |_: u64| {
-            if run.stop.load(Ordering::Relaxed) || Instant::now() >= run.deadline {
-                cancel.store(true, Ordering::Relaxed);
-            }
-            (run.tick)();
+        // Pass sizes double, so a pass costs about all before it.
+        let predicted = per_spp * p.next_pass_size() as f64;
+        stopped = if p.finished() || run.target_error.is_some_and(|t| p.estimated_relative_error() < t) {
+            None // run_passes says which
+        } else if run.stop.load(Ordering::Relaxed) {
+            Some(Stop::User)
+        } else if now >= run.deadline {
+            Some(Stop::Deadline)
+        } else if seconds + predicted > run.share {
+            Some(Stop::Share)
+        } else if now + Duration::from_secs_f64(predicted.min(1e9)) > run.deadline {
+            Some(Stop::Deadline)
+        } else {
+            None
         };
-        let observer = RenderObserver { progress: Some(&tile_done), cancel: Some(&cancel) };
-        let size = progressive.next_pass_size();
-        let start = Instant::now();
-        let finished = run.pool.install(|| progressive.pass(run.scene, run.integrator, &observer));
-        let took = start.elapsed().as_secs_f64();
-        if !finished {
-            return Ok(if run.stop.load(Ordering::Relaxed) { Stop::User } else { Stop::Deadline });
-        }
-        seconds += took;
-        per_spp = Some(took / size as f64);
-        if !rung(&progressive, seconds)? {
-            return Ok(Stop::Caller);
-        }
-    }
+        size = p.next_pass_size();
+        pass_start = Instant::now();
+        Ok(if stopped.is_some() { ControlFlow::Break(()) } else { ControlFlow::Continue(()) })
+    };
+    let (scene, integrator) = (run.scene, run.integrator);
+    let end =
+        run.job.run_passes(run.pool, scene, integrator, &mut progressive, &observer, run.target_error, after_pass)?;
+    Ok(match end {
+        PassesEnd::Finished => Stop::Spp,
+        PassesEnd::Target => Stop::Target,
+        PassesEnd::Cancelled if run.stop.load(Ordering::Relaxed) => Stop::User,
+        PassesEnd::Cancelled => Stop::Deadline,
+        PassesEnd::Caller => stopped.unwrap_or(Stop::Caller),
+    })
 }
 
 /// Pixels per side of the grid a probe times.
@@ -199,9 +209,13 @@ mod tests {
         let pool = rayon::ThreadPoolBuilder::new().num_threads(2).build().unwrap();
         let stop = AtomicBool::new(false);
         let start = Instant::now();
+        let job = airlight::render::RenderRequest { cancellable: true, ..Default::default() }
+            .check(scene.settings(), airlight::integrator::IntegratorKind::Direct)
+            .unwrap();
         let run = Run {
             scene: &scene,
             integrator,
+            job: &job,
             pool: &pool,
             stop: &stop,
             deadline: start + Duration::from_secs_f64(seconds),

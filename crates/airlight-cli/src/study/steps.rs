@@ -56,6 +56,7 @@ pub fn truths(
         let run = Run {
             scene,
             integrator: integrator.as_ref(),
+            job: &ctx.job,
             pool: &ctx.pool,
             stop: &ctx.stop,
             deadline: ctx.deadline,
@@ -251,6 +252,7 @@ fn series(
     let run = Run {
         scene,
         integrator,
+        job: &ctx.job,
         pool: &ctx.pool,
         stop: &ctx.stop,
         deadline: ctx.deadline,

@@ -82,12 +82,13 @@ pub fn run(args: ViewArgs) -> Result<(), String> {
         ),
     };
     let scene = &file.scene;
-    let pixels = args.width as u64 * args.height as u64;
-    airlight::memory::check(
-        format!("a {}×{} view", args.width, args.height),
-        airlight::render::RenderMode::Progressive { cancellable: false }.bytes(pixels),
-    )
-    .map_err(|e| format!("{e}: make it smaller (--width, --height)"))?;
+    // The view's frames add samples into running sums, as passes do: a
+    // progressive job of the window's size, on its threads.
+    let mut settings = scene.settings().clone();
+    (settings.film.width, settings.film.height) = (args.width, args.height);
+    let request = airlight::render::RenderRequest { passes: true, threads: args.threads, ..Default::default() };
+    let job = request.check(&settings, file.integrator.kind)?;
+    job.mode.check_memory(&settings.film).map_err(|e| format!("{e}: make it smaller (--width, --height)"))?;
     crate::preflight::warn_if_dark(scene, true);
     if let Some(dir) = args.out.as_deref().filter(|_| args.headless) {
         let names = (0..args.frames).flat_map(|k| ["exr", "png"].map(|ext| format!("frame_{k:04}.{ext}")));
@@ -108,7 +109,7 @@ pub fn run(args: ViewArgs) -> Result<(), String> {
         None => Script::scene_keyframes(),
     };
     let start = Start { camera: *scene.camera(), lights: scene.lights().to_vec(), paths: scene.light_paths().to_vec() };
-    let pool = airlight::render::thread_pool(args.threads)?;
+    let pool = job.thread_pool()?;
     pool.install(|| {
         let mode = args.integrator.or(script.integrator).unwrap_or(Mode::Preview);
         let t = std::time::Instant::now();

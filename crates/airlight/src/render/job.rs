@@ -78,6 +78,9 @@ pub struct RenderRequest {
     pub tile: Option<(u32, u32)>,
     /// Render in passes (progressive output, an error target).
     pub passes: bool,
+    /// Passes that may be cancelled part way (a deadline), each adding
+    /// into sums of its own first so that a cancelled one adds nothing.
+    pub cancellable: bool,
     /// Also the estimated variance of each pixel's mean (rendered in
     /// passes).
     pub variance: bool,
@@ -125,7 +128,7 @@ impl RenderRequest {
         let rows = rows.start as u32..rows.end as u32;
         let partial = self.shard.is_some() || self.tile.is_some();
         let variance = self.variance || self.aovs.contains(&Aov::Variance);
-        let passes = self.passes || variance;
+        let passes = self.passes || self.cancellable || variance;
         if partial && !self.aovs.is_empty() {
             return Err("AOVs: a shard or tile holds part of the samples as sums; render the AOVs with the merged \
                         image's settings, without a shard or tile"
@@ -165,7 +168,7 @@ impl RenderRequest {
         let mode = if partial {
             RenderMode::Partial
         } else if passes {
-            RenderMode::Progressive { cancellable: false }
+            RenderMode::Progressive { cancellable: self.cancellable }
         } else if settings.adaptive {
             RenderMode::Adaptive
         } else {
@@ -185,13 +188,6 @@ impl RenderJob {
     pub fn thread_pool(&self) -> Result<rayon::ThreadPool, String> {
         pool(self.threads)
     }
-}
-
-/// Worker threads for work outside a render job (a viewer, a radiosity
-/// timing): `threads` of them, from 1 to [`MAX_THREADS`], or one a core.
-pub fn thread_pool(threads: Option<u32>) -> Result<rayon::ThreadPool, String> {
-    let job = RenderRequest { threads, ..Default::default() };
-    job.check(&RenderSettings::default(), IntegratorKind::Direct)?.thread_pool()
 }
 
 fn pool(threads: usize) -> Result<rayon::ThreadPool, String> {

@@ -16,9 +16,11 @@ use std::sync::atomic::{AtomicBool, Ordering};
 pub mod adaptive;
 pub mod aov;
 mod job;
+mod run;
 mod samples;
 
-pub use job::{MAX_THREADS, RenderJob, RenderMode, RenderRequest, thread_pool};
+pub use job::{MAX_THREADS, RenderJob, RenderMode, RenderRequest};
+pub use run::{PassesEnd, Rendered};
 use samples::tile_sums;
 pub use samples::{BLOCK, BLOCK_ORDER, PixelSample, pixel_sum};
 
