@@ -96,6 +96,20 @@ fn check_render_keys(render: &RenderDesc, text: &str) -> Result<(), SceneError> 
 }
 
 impl SceneFile {
+    /// Every tag, type name and key of the typed tables (`[camera]`,
+    /// `[medium]`, `[materials.NAME]`, `[[objects]]` with their SDF nodes,
+    /// `[[lights]]`), each once, as their structs declare them.
+    pub fn table_words() -> Vec<&'static str> {
+        let mut words = Vec::new();
+        tables::words::<desc::CameraDesc>(&mut words);
+        tables::words::<desc::MediumDesc>(&mut words);
+        tables::words::<desc::MaterialDesc>(&mut words);
+        tables::words::<desc::ObjectDesc>(&mut words);
+        tables::words::<desc::SdfNodeDesc>(&mut words);
+        tables::words::<desc::LightDesc>(&mut words);
+        words
+    }
+
     /// The keys `[render]` takes: the film settings, then the integrators'
     /// options.
     pub fn render_keys() -> impl Iterator<Item = &'static str> {

@@ -213,6 +213,19 @@ impl<'a> Checker<'a> {
     }
 }
 
+/// The family's tag, its types' names and every key they take, each once,
+/// added to `words`.
+pub(super) fn words<T: Tagged>(words: &mut Vec<&'static str>) {
+    let keys = T::TYPES.iter().flat_map(|t| T::keys(t).iter().copied());
+    for word in
+        [T::TAG].into_iter().chain(T::TYPES.iter().copied()).chain(keys_of::<T::Shared>().iter().copied()).chain(keys)
+    {
+        if !words.contains(&word) {
+            words.push(word);
+        }
+    }
+}
+
 /// Why `key` is not a key of type `name`: the types that take it, or the
 /// keys the type takes (with the nearest, when it looks like a slip).
 fn misplaced<T: Tagged>(key: &str, name: &str, own: &[&str], shared: &[&str]) -> String {

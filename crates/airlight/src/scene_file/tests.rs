@@ -161,3 +161,49 @@ fn a_medium_from_command_line_options_follows_the_scene_file_rules() {
         assert!(e.contains(message), "{options}: {e}");
     }
 }
+
+/// The text of docs/scene-format.md from the heading `## {heading}` to
+/// the next `## `.
+fn format_section(heading: &str) -> String {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../docs/scene-format.md");
+    let text = std::fs::read_to_string(path).expect("docs/scene-format.md");
+    let start = text.find(&format!("\n## {heading}\n")).unwrap_or_else(|| panic!("no section {heading}"));
+    let rest = &text[start + 1..];
+    let end = rest[3..].find("\n## ").map_or(rest.len(), |i| i + 3);
+    rest[..end].to_string()
+}
+
+/// Every type of a family and every key its struct declares is named in
+/// the family's section of the scene format: a key added to a type is
+/// documented where users look for it.
+fn documented<T: tables::Tagged>(heading: &str) -> Vec<String> {
+    let section = format_section(heading);
+    let named = |word: &str| section.contains(&format!("`{word}`")) || section.contains(&format!("`{word} = "));
+    let mut missing = Vec::new();
+    let shared = tables::keys_of::<T::Shared>();
+    for name in T::TYPES {
+        if !named(name) {
+            missing.push(format!("{heading}: type `{name}`"));
+        }
+        for key in T::keys(name).iter().chain(shared) {
+            if !named(key) && !missing.iter().any(|m| m.ends_with(&format!("key `{key}`"))) {
+                missing.push(format!("{heading}: key `{key}`"));
+            }
+        }
+    }
+    missing
+}
+
+#[test]
+fn the_scene_format_names_every_type_and_key() {
+    let missing: Vec<String> = [
+        documented::<desc::CameraDesc>("`[camera]`"),
+        documented::<desc::MediumDesc>("`[medium]`"),
+        documented::<desc::MaterialDesc>("`[materials.NAME]`"),
+        documented::<desc::ObjectDesc>("`[[objects]]`"),
+        documented::<desc::SdfNodeDesc>("`[[objects]]`"),
+        documented::<desc::LightDesc>("`[[lights]]`"),
+    ]
+    .concat();
+    assert!(missing.is_empty(), "not in docs/scene-format.md:\n{}", missing.join("\n"));
+}
