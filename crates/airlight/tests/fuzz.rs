@@ -13,102 +13,30 @@
 
 #[path = "fuzz/mutate.rs"]
 mod mutate;
+#[path = "fuzz/run.rs"]
+mod run;
 
 use airlight::film::{self, Image};
 use airlight::integrator::IntegratorKind;
 use airlight::{RenderObserver, Rgb, SceneFile};
 use mutate::{Rng, mutate_bytes, mutate_obj, mutate_text, mutate_tree};
-use std::panic::{AssertUnwindSafe, catch_unwind};
+use run::{count, fuzz};
 use std::path::Path;
-use std::time::Instant;
 
-/// Key and value names of the scene format, for renames and swaps, besides
-/// the keys of `[render]` (see [`names`]).
-const OTHER_NAMES: &[&str] = &[
-    "render",
-    "camera",
-    "medium",
-    "materials",
-    "objects",
-    "lights",
-    "type",
-    "position",
-    "look_at",
-    "up",
-    "fov",
-    "view_height",
-    "aperture",
-    "focus_distance",
-    "distance",
-    "sigma_a",
-    "sigma_s",
-    "g",
-    "base",
-    "falloff",
-    "albedo",
-    "albedo2",
-    "scale",
-    "specular",
-    "exponent",
-    "material",
-    "center",
-    "radius",
-    "point",
-    "normal",
-    "corner",
-    "edge_u",
-    "edge_v",
-    "min",
-    "max",
-    "file",
-    "translate",
-    "rotate",
-    "shape",
-    "children",
-    "blend",
-    "intensity",
-    "direction",
-    "cone_angle",
-    "falloff_start",
-    "irradiance",
-    "radiance",
-    "attenuation",
-    "cutoff",
-    "range",
-    "keyframes",
-    "time",
-    "volume",
-    "start",
-    "end",
-    "profile",
-    "sphere",
-    "plane",
-    "quad",
-    "box",
-    "mesh",
-    "sdf",
-    "point",
-    "spot",
-    "distant",
-    "line",
-    "path",
-    "analytic",
-    "stochastic",
-    "raymarch",
-    "direct",
-    "radiosity",
-    "isometric",
-    "orthographic",
-    "checker",
-    "phong",
-    "smooth_union",
-    "mesh.obj",
-];
+/// Names the declarations do not give: the tables, a keyframe's `time`,
+/// the mesh file's name.
+const OTHER_NAMES: &[&str] =
+    &["render", "camera", "medium", "materials", "objects", "lights", "include", "time", "mesh.obj"];
 
-/// Every key and value name the mutations use: the `[render]` keys as
-/// declared, then [`OTHER_NAMES`].
+/// Every key and value name the mutations use, as declared: the `[render]`
+/// keys and integrator names, every typed table's tag, types and keys,
+/// then [`OTHER_NAMES`].
 fn names() -> Vec<&'static str> {
-    airlight::SceneFile::render_keys().chain(OTHER_NAMES.iter().copied()).collect()
+    airlight::SceneFile::render_keys()
+        .chain(airlight::integrator::IntegratorKind::NAMES)
+        .chain(airlight::SceneFile::table_words())
+        .chain(OTHER_NAMES.iter().copied())
+        .collect()
 }
 
 /// A scene with a mesh, and the mesh: a cube of quads, with the
@@ -137,47 +65,6 @@ intensity = 20
 const CUBE_OBJ: &str = "# cube\nmtllib cube.mtl\no cube\nv -1 -1 -1\nv 1 -1 -1\nv 1 1 -1\nv -1 1 -1\nv -1 -1 1\n\
 v 1 -1 1\nv 1 1 1\nv -1 1 1\nvt 0 0\nvn 0 0 -1\nusemtl grey\ns off\nf 1/1/1 2/1/1 3/1/1 4/1/1\nf 5 8 7 6\n\
 f 1 5 6 2\nf 2 6 7 3\nf 3 7 8 4\nf -8 -4 -1 -5\n";
-
-fn count(default: u64) -> u64 {
-    std::env::var("AIRLIGHT_FUZZ_INPUTS").ok().and_then(|v| v.parse().ok()).unwrap_or(default)
-}
-
-fn panic_message(payload: Box<dyn std::any::Any + Send>) -> String {
-    payload
-        .downcast_ref::<&str>()
-        .map(|s| s.to_string())
-        .or_else(|| payload.downcast_ref::<String>().cloned())
-        .unwrap_or_else(|| "(a panic without a message)".into())
-}
-
-/// Runs `n` inputs (or the one of `AIRLIGHT_FUZZ_SEED`), `one(seed)` each,
-/// and fails listing the seeds of any that panicked or misreported.
-fn fuzz(what: &str, base: u64, n: u64, mut one: impl FnMut(u64) -> Result<bool, String>) {
-    let seeds: Vec<u64> = match std::env::var("AIRLIGHT_FUZZ_SEED").ok().and_then(|s| s.parse().ok()) {
-        Some(seed) => vec![seed],
-        None => (0..n).map(|i| mutate::seed(base, i)).collect(),
-    };
-    let start = Instant::now();
-    let (mut accepted, mut failures) = (0u64, Vec::new());
-    for &seed in &seeds {
-        match catch_unwind(AssertUnwindSafe(|| one(seed))) {
-            Ok(Ok(ok)) => accepted += ok as u64,
-            Ok(Err(message)) => failures.push((seed, message)),
-            Err(payload) => failures.push((seed, format!("panic: {}", panic_message(payload)))),
-        }
-    }
-    eprintln!(
-        "fuzz {what}: {} inputs in {:.1} s, {accepted} accepted, {} refused, {} failures",
-        seeds.len(),
-        start.elapsed().as_secs_f64(),
-        seeds.len() as u64 - accepted - failures.len() as u64,
-        failures.len()
-    );
-    for (seed, message) in failures.iter().take(20) {
-        eprintln!("  AIRLIGHT_FUZZ_SEED={seed}: {message}");
-    }
-    assert!(failures.is_empty(), "{} of {} {what} inputs failed (seeds above)", failures.len(), seeds.len());
-}
 
 fn base_scenes() -> Vec<toml::Table> {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes");
