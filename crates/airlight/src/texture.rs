@@ -175,6 +175,11 @@ impl Texture {
         // f64: a coordinate of 1e6 still resolves a texel of a 16k image.
         let x = u as f64 * self.width as f64 - 0.5;
         let y = v as f64 * self.height as f64 - 0.5;
+        // Beyond 2⁵² a float has no fraction left; held there, the texel
+        // indices and their neighbours stay within i64 (u = 3e38 is a
+        // texture coordinate a file may hold).
+        const FAR: f64 = (1u64 << 52) as f64;
+        let (x, y) = (x.clamp(-FAR, FAR), y.clamp(-FAR, FAR));
         let (x0, y0) = (x.floor(), y.floor());
         let (fx, fy) = ((x - x0) as f32, (y - y0) as f32);
         let (x0, y0) = (x0 as i64, y0 as i64);
@@ -187,6 +192,15 @@ impl Texture {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn coordinates_at_the_ends_of_f32_sample_a_texel() {
+        let t = Texture::from_srgb8(2, 1, vec![[255, 0, 0], [0, 0, 255]]).unwrap();
+        for (u, v) in [(3.4e38, 0.5), (-3.4e38, 0.5), (0.5, 3.4e38), (1e20, -1e20)] {
+            let c = t.sample(u, v);
+            assert!(c.is_finite() && c.min_element() >= 0.0 && c.max_element() <= 1.0, "({u}, {v}): {c}");
+        }
+    }
 
     #[test]
     fn srgb_decode_matches_the_standard_at_known_points() {

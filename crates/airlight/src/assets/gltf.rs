@@ -64,7 +64,9 @@ impl Loader<'_> {
         let path = self.resolve(name).map_err(|why| fail(format!("cannot load: {why}")))?;
         let bytes = read_limited(&path, MAX_MESH_BYTES).map_err(|why| fail(format!("cannot load: {why}")))?;
         // The crate validates the document, and refuses one that requires
-        // an extension other than those Airlight reads (Cargo.toml).
+        // an extension other than those Airlight reads (Cargo.toml); what
+        // it would panic on is refused first.
+        before_the_crate(&bytes).map_err(|why| fail(format!("not a valid glTF file: {why}")))?;
         let gltf = gltf::Gltf::from_slice(&bytes).map_err(|e| fail(format!("not a valid glTF file: {e}")))?;
         self.record(path);
         let buffers = self.gltf_buffers(&gltf, Path::new(name)).map_err(fail)?;
@@ -312,6 +314,70 @@ impl Loader<'_> {
     }
 }
 
+/// Refuses what the `gltf` crate (1.4) panics on rather than reporting,
+/// found by fuzzing (tests/fuzz_imports.rs): a GLB whose header gives a
+/// length below the header's own 12 bytes (a subtraction that overflows),
+/// a mesh primitive's attribute naming an accessor that does not exist
+/// (its validation indexes the accessors before it checks the index), an
+/// image in a buffer view without a `mimeType`, and an image with neither
+/// a `uri` nor a buffer view (both required by the glTF 2.0
+/// specification, read with `unwrap`). Anything else is left to
+/// the crate's own validation.
+fn before_the_crate(bytes: &[u8]) -> Result<(), String> {
+    let json = match bytes.strip_prefix(b"glTF") {
+        Some(rest) => {
+            let word = |at: usize| rest.get(at..at + 4).map(|w| u32::from_le_bytes([w[0], w[1], w[2], w[3]]));
+            match word(4) {
+                Some(length) if length >= 12 => {}
+                Some(length) => {
+                    return Err(format!("its GLB header gives a length of {length} bytes, less than the header"));
+                }
+                None => return Err("its GLB header is cut short".into()),
+            }
+            // The JSON chunk: its length, its type, its bytes.
+            let length = word(8).unwrap_or(0) as usize;
+            match rest.get(16..16usize.saturating_add(length)) {
+                Some(chunk) => chunk,
+                None => return Ok(()), // the crate reports a short chunk
+            }
+        }
+        None => bytes,
+    };
+    let Ok(doc) = serde_json::from_slice::<serde_json::Value>(json) else {
+        return Ok(()); // the crate reports what is wrong with the JSON
+    };
+    let count = |key: &str| doc.get(key).and_then(|v| v.as_array()).map_or(0, Vec::len) as u64;
+    let accessors = count("accessors");
+    let items = |key: &str| doc.get(key).and_then(|v| v.as_array()).cloned().unwrap_or_default();
+    for (m, mesh) in items("meshes").iter().enumerate() {
+        let primitives = mesh.get("primitives").and_then(|p| p.as_array()).cloned().unwrap_or_default();
+        for (p, primitive) in primitives.iter().enumerate() {
+            let Some(attributes) = primitive.get("attributes").and_then(|a| a.as_object()) else { continue };
+            for (name, index) in attributes {
+                if let Some(i) = index.as_u64().filter(|&i| i >= accessors) {
+                    return Err(format!(
+                        "meshes[{m}].primitives[{p}].attributes.{name}: accessor {i} does not exist (the file has {accessors})"
+                    ));
+                }
+            }
+        }
+    }
+    for (i, image) in items("images").iter().enumerate() {
+        // A key whose value is null reads as absent.
+        let given = |key: &str| image.get(key).filter(|v| !v.is_null());
+        match (given("bufferView"), given("uri")) {
+            (Some(_), _) if !image.get("mimeType").is_some_and(|m| m.is_string()) => {
+                return Err(format!("images[{i}]: an image in a buffer view needs a `mimeType`"));
+            }
+            (None, uri) if !uri.is_some_and(|u| u.is_string()) => {
+                return Err(format!("images[{i}]: an image needs a `uri` or a `bufferView`"));
+            }
+            _ => {}
+        }
+    }
+    Ok(())
+}
+
 fn wrap(mode: gltf::texture::WrappingMode) -> Wrap {
     match mode {
         gltf::texture::WrappingMode::Repeat => Wrap::Repeat,
@@ -413,9 +479,11 @@ fn fits(accessor: &gltf::Accessor, buffers: &[Vec<u8>]) -> Result<(), String> {
         return Err(format!("bufferViews[{}] runs past the end of its buffer", view.index()));
     }
     let stride = view.stride().unwrap_or(accessor.size());
+    // The specification's least count is 1; the crate's reader takes
+    // count − 1 unchecked.
     let end = match accessor.count() {
-        0 => Some(0),
-        n => (n - 1).checked_mul(stride).and_then(|s| s.checked_add(accessor.offset() + accessor.size())),
+        0 => return Err(format!("accessors[{}] has count 0; at least 1 is required", accessor.index())),
+        n => (n - 1).checked_mul(stride).and_then(|s| s.checked_add(accessor.offset().checked_add(accessor.size())?)),
     };
     if end.is_none_or(|end| end > view.length()) {
         return Err(format!("{} elements run past the end of bufferViews[{}]", accessor.count(), view.index()));
