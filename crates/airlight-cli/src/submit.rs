@@ -6,6 +6,9 @@
 //! (`sbatch --array=K WORK/render.sh`) and the merge after it
 //! (`sbatch WORK/merge.sh`).
 
+#[cfg(test)]
+mod fuzz;
+
 use crate::render::{RenderArgs, numbered, prepare};
 use clap::Parser;
 use std::fmt::Write as _;
