@@ -218,3 +218,20 @@ fn bad_options_give_clear_errors_before_any_render() {
     let out = airlight(dir.path(), &["study", "no-such.toml"]);
     assert!(!out.status.success() && String::from_utf8_lossy(&out.stderr).contains("no-such.toml"));
 }
+
+#[test]
+fn a_budget_too_small_for_anything_leaves_no_report() {
+    let dir = tempfile::tempdir().unwrap();
+    let cornell = scene("cornell_box.toml");
+    let args = ["study", &cornell, "--width", "64", "--height", "64", "--time-budget", "0.001", "-o", "r", "--quiet"];
+    let out = airlight(dir.path(), &args);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success() && stderr.contains("give a larger --time-budget"), "{stderr}");
+    assert!(!dir.path().join("r").exists(), "an empty report was left: {stderr}");
+    // An earlier report in the folder is left as it was.
+    std::fs::create_dir(dir.path().join("r")).unwrap();
+    std::fs::write(dir.path().join("r/index.html"), "earlier").unwrap();
+    let out = airlight(dir.path(), &args);
+    assert!(!out.status.success());
+    assert_eq!(std::fs::read_to_string(dir.path().join("r/index.html")).unwrap(), "earlier");
+}

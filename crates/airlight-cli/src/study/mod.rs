@@ -102,8 +102,8 @@ const REPORT_FILES: [&str; 8] = [
 /// write (outputs.rs): the report's files and the JSON may replace neither
 /// the scene nor a file it was read from, nor each other. Refuses a
 /// non-empty folder that holds no earlier report, rather than mixing files
-/// into it.
-fn prepare_dir(dir: &Path, args: &StudyArgs, scene: &Scene) -> Result<(), String> {
+/// into it. Returns whether it made the folder.
+fn prepare_dir(dir: &Path, args: &StudyArgs, scene: &Scene) -> Result<bool, String> {
     let shown = dir.display();
     let existed = dir.exists();
     if existed {
@@ -131,7 +131,16 @@ fn prepare_dir(dir: &Path, args: &StudyArgs, scene: &Scene) -> Result<(), String
         std::fs::create_dir_all(dir.join(sub))
             .map_err(|e| format!("cannot create `{}`: {e}", dir.join(sub).display()))?;
     }
-    Ok(())
+    Ok(!existed)
+}
+
+/// Removes the report folder this study made when it finished nothing: its
+/// two empty subfolders and itself (`remove_dir` leaves anything else).
+fn remove_empty_report(dir: &Path) {
+    for sub in ["exr", "images"] {
+        let _ = std::fs::remove_dir(dir.join(sub));
+    }
+    let _ = std::fs::remove_dir(dir);
 }
 
 /// Refuses a study whose images would not fit in memory: a progressive
@@ -200,7 +209,7 @@ pub fn study(args: StudyArgs) -> Result<(), String> {
     let job = request.check(scene.settings(), desc.kind)?;
     check_memory(&scene, &job, plan::ladder(&scene, &desc, &kinds).0.len())?;
     crate::preflight::warn_if_dark(&scene, true);
-    prepare_dir(&dir, &args, &scene)?;
+    let made_dir = prepare_dir(&dir, &args, &scene)?;
     let pool = job.thread_pool()?;
     let stop = Arc::new(AtomicBool::new(false));
     for signal in [signal_hook::consts::SIGINT, signal_hook::consts::SIGTERM] {
@@ -239,13 +248,26 @@ pub fn study(args: StudyArgs) -> Result<(), String> {
         series: Vec::new(),
         not_run: Vec::new(),
     };
-    // At once, so that a path that cannot be written fails before any render.
-    ctx.report(&mut study)?;
+    // (Where the report goes was checked by prepare_dir: it is written
+    // once there is something in it.)
     let outcome = steps::truths(&ctx, &mut scene, &desc, &args, &mut study)
         .and_then(|truths| steps::ladder(&ctx, &scene, &desc, &args, &kinds, &truths, &mut study));
     ctx.progress.finish();
     let stopped = ctx.stop.load(Ordering::Relaxed);
     study.state = if stopped { State::Stopped } else { State::Finished };
+    if study.truths.iter().all(|t| t.spp == 0) {
+        // Nothing finished (a budget too small for the first pass, Ctrl-C
+        // at once): no empty report, and an earlier one is left as it was.
+        if made_dir {
+            remove_empty_report(&dir);
+        }
+        outcome?;
+        return Err(if stopped {
+            "stopped by Ctrl-C before anything was finished".into()
+        } else {
+            "nothing was finished, so no report was written".into()
+        });
+    }
     // The report of what was finished, even after an error.
     let written = ctx.report(&mut study);
     outcome?;
