@@ -3,6 +3,7 @@
 use airlight::SceneFile;
 use airlight::film::{self, Image};
 use airlight::integrator::IntegratorKind;
+use airlight::light::Light;
 use clap::{Parser, Subcommand};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -140,7 +141,13 @@ fn info(path: &Path) -> Result<(), String> {
     println!("geometry: {prims} bounded primitives, {planes} planes");
     println!("materials: {}", scene.materials().len());
     println!("lights: {}", scene.lights().len());
-    for (light, path) in scene.lights().iter().zip(scene.light_paths()) {
+    // An emitting mesh is a light per triangle: counted, not listed.
+    let triangles = scene.lights().iter().filter(|l| matches!(l, Light::Triangle { .. })).count();
+    if triangles > 0 {
+        println!("  {triangles} triangles of emitting meshes");
+    }
+    let others = scene.lights().iter().zip(scene.light_paths()).filter(|(l, _)| !matches!(l, Light::Triangle { .. }));
+    for (light, path) in others {
         println!("  {light:?}");
         if let Some(path) = path {
             println!("    moves along {} keyframes", path.keys().len());

@@ -314,7 +314,12 @@ impl Loader<'_> {
     }
 }
 
-/// Refuses what the `gltf` crate (1.4) panics on rather than reporting,
+/// The glTF extensions Airlight reads (the `gltf` crate's features in
+/// Cargo.toml).
+const READ_EXTENSIONS: [&str; 2] = ["KHR_lights_punctual", "KHR_materials_emissive_strength"];
+
+/// Refuses an extension the file requires and Airlight does not read, and
+/// what the `gltf` crate (1.4) panics on rather than reporting,
 /// found by fuzzing (tests/fuzz_imports.rs): a GLB whose header gives a
 /// length below the header's own 12 bytes (a subtraction that overflows),
 /// a mesh primitive's attribute naming an accessor that does not exist
@@ -346,6 +351,16 @@ fn before_the_crate(bytes: &[u8]) -> Result<(), String> {
     let Ok(doc) = serde_json::from_slice::<serde_json::Value>(json) else {
         return Ok(()); // the crate reports what is wrong with the JSON
     };
+    // A required extension Airlight does not read (Draco, meshopt) is the
+    // one thing to say: the crate would list every accessor it leaves
+    // without data first.
+    let required = doc.get("extensionsRequired").and_then(|r| r.as_array()).cloned().unwrap_or_default();
+    if let Some(name) = required.iter().filter_map(|e| e.as_str()).find(|e| !READ_EXTENSIONS.contains(e)) {
+        return Err(format!(
+            "it requires the extension `{name}`, which Airlight does not read (it reads {}); export the file without it",
+            READ_EXTENSIONS.join(", ")
+        ));
+    }
     let count = |key: &str| doc.get(key).and_then(|v| v.as_array()).map_or(0, Vec::len) as u64;
     let accessors = count("accessors");
     let items = |key: &str| doc.get(key).and_then(|v| v.as_array()).cloned().unwrap_or_default();
