@@ -204,6 +204,14 @@ fn cases() -> Vec<(String, usize, &'static str)> {
         ),
         // 33. An isometric camera's key on a perspective one (once ignored).
         (with("[camera]\ndistance = 20"), 2, "`distance` is a key of isometric cameras, not of perspective cameras"),
+        // 35. A keyframe without its time: said of the keyframe, at it.
+        (
+            format!(
+                "{GOOD_TAIL}\n[[lights]]\ntype = \"point\"\nposition = [0, 3, 0]\nintensity = 5\nkeyframes = [{{ position = [0, 1, 0] }}]\n"
+            ),
+            20,
+            "lights[1] (point): missing field `time`",
+        ),
         // 34. A key no type takes, a slip away from one this type takes.
         (
             format!("{GOOD_TAIL}\n[[lights]]\ntype = \"point\"\nposition = [0, 3, 0]\nintensity = 5\nintensty = 5\n"),

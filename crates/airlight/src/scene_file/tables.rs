@@ -5,7 +5,8 @@
 //! that the chosen type does not declare is an error at the key, naming the
 //! types that do take it ("`cone_angle` is a key of spot lights, not of
 //! point lights"). Like pbrt-v4's report of unused parameters and Mitsuba
-//! 3's of unqueried properties, but found before anything is built.
+//! 3's of unqueried properties, but each table's keys are checked before
+//! any of its values is used.
 //!
 //! The tables are read from the spanned document (`toml::de::DeTable`),
 //! so that nested values keep their place in the text.
@@ -39,8 +40,9 @@ pub(super) fn element<'d, 'i>(value: &'d TableValue<'i>, index: usize) -> Option
 }
 
 /// A table's place in the file, all the description keeps of a table that
-/// is read later by its type's struct (the `[[lights]]`, `[[objects]]`,
-/// `[materials]` and `[medium]` tables, an SDF node's `children`).
+/// is read later by its type's struct (the `[camera]`, `[medium]`,
+/// `[materials]`, `[[objects]]` and `[[lights]]` tables, an SDF node's
+/// `children`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct TableAt;
 
@@ -183,7 +185,10 @@ impl<'a> Checker<'a> {
         let fail = |e: toml::de::Error| {
             let at = e.span().map_or(span.start, |s| s.start);
             let message = e.message().trim_end();
-            match message.strip_prefix("missing field `").and_then(|m| m.strip_suffix('`')) {
+            // A key the type needs and the table lacks (a nested table's
+            // missing key is placed at that table, as serde says it).
+            let missing = message.strip_prefix("missing field `").and_then(|m| m.strip_suffix('`'));
+            match missing.filter(|_| e.span() == Some(span.clone())) {
                 Some(key) => self.err(span.clone(), format!("{label} ({name}): a {name} {singular} needs `{key}`")),
                 None => self.err(at..at, format!("{label} ({name}): {message}")),
             }
