@@ -28,6 +28,7 @@ fn load(py: Python<'_>, path: PathBuf) -> PyResult<PyScene> {
         let file = py
             .detach(|| airlight::SceneFile::load_with(&path, &extra))
             .map_err(|e| errors::scene_error(py, &e, &Origin::File, ""))?;
+        scene::warn_notes(py, &file.scene)?;
         // Kept for `Scene.toml` and `with_lights`: the file, which the
         // library has just read within its size limit, or for a glTF file
         // the scene file the library reads it as.

@@ -72,7 +72,18 @@ pub struct PyScene {
 pub fn read(py: Python<'_>, source: Source) -> PyResult<PyScene> {
     let parsed = py.detach(|| SceneFile::from_toml_with(&source.text, &source.assets));
     let file = parsed.map_err(|e| scene_error(py, &e, &source.origin, &source.text))?;
+    warn_notes(py, &file.scene)?;
     Ok(new_scene(file, source))
+}
+
+/// A UserWarning for each thing the scene asks for that Airlight does not
+/// read (a glTF file's normal maps, say), as the CLI warns of them.
+pub fn warn_notes(py: Python<'_>, scene: &airlight::Scene) -> PyResult<()> {
+    for note in scene.notes() {
+        let message = std::ffi::CString::new(note.as_str()).unwrap_or_default();
+        PyErr::warn(py, &py.get_type::<PyUserWarning>(), &message, 1)?;
+    }
+    Ok(())
 }
 
 /// The Python scene of a scene file read from `source`.

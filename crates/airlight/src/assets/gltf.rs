@@ -41,6 +41,9 @@ const MAX_PLACED_NODES: u64 = 1 << 20;
 /// What a glTF file adds to a scene.
 pub(crate) struct Imported {
     pub parts: Parts,
+    /// What the file asks for that Airlight does not read (see
+    /// [`not_read`]), for the user to be told.
+    pub notes: Vec<String>,
     /// The first camera met, with its aspect ratio when the file gives one.
     pub camera: Option<(Camera, Option<f32>)>,
 }
@@ -66,7 +69,7 @@ impl Loader<'_> {
         // The crate validates the document, and refuses one that requires
         // an extension other than those Airlight reads (Cargo.toml); what
         // it would panic on is refused first.
-        before_the_crate(&bytes).map_err(|why| fail(format!("not a valid glTF file: {why}")))?;
+        let doc = before_the_crate(&bytes).map_err(|why| fail(format!("not a valid glTF file: {why}")))?;
         let gltf = gltf::Gltf::from_slice(&bytes).map_err(|e| fail(format!("not a valid glTF file: {e}")))?;
         self.record(path);
         let buffers = self.gltf_buffers(&gltf, Path::new(name)).map_err(fail)?;
@@ -89,7 +92,9 @@ impl Loader<'_> {
         self.reserve(bytes, || format!("the scene's meshes ({triangles} triangles placed by this glTF)"))
             .map_err(fail)?;
 
-        let mut out = Imported { parts: Parts::default(), camera: None };
+        let unread = doc.as_ref().map(not_read).unwrap_or_default();
+        let notes = unread.into_iter().map(|what| format!("{}: `{name}`: {what}", include.label)).collect();
+        let mut out = Imported { parts: Parts::default(), notes, camera: None };
         let mut textures = Textures { file: Path::new(name), buffers: &buffers, read: HashMap::new() };
         let mut stack: Vec<(gltf::Node, Affine3A, usize)> =
             scene.nodes().map(|n| (n, include.transform, 0)).collect::<Vec<_>>();
@@ -314,21 +319,73 @@ impl Loader<'_> {
     }
 }
 
+/// What a glTF file's materials, meshes and extensions ask for that
+/// Airlight does not read, each with what the image shows instead: the
+/// file loads, but it does not render as its author saw it, and the user
+/// is told so rather than left to find out. Read from the JSON itself
+/// (`doc`), defaults as the glTF 2.0 specification gives them.
+fn not_read(doc: &serde_json::Value) -> Vec<String> {
+    use serde_json::Value;
+    let empty = Vec::new();
+    let materials = doc.get("materials").and_then(Value::as_array).unwrap_or(&empty);
+    let number = |v: Option<&Value>, default: f64| v.and_then(Value::as_f64).unwrap_or(default);
+    let count = |test: &dyn Fn(&Value) -> bool| materials.iter().filter(|m| test(m)).count();
+    let mut notes = Vec::new();
+    let mut note = |n: usize, what: &str, instead: &str| {
+        if n > 0 {
+            let of = if n == 1 { "1 material".to_string() } else { format!("{n} materials") };
+            notes.push(format!("{what} ({of}) not read: {instead}"));
+        }
+    };
+    let cut_out = |m: &Value| m.get("alphaMode").and_then(Value::as_str).is_some_and(|a| a != "OPAQUE");
+    note(count(&cut_out), "alphaMode MASK or BLEND", "cut-outs and glass are opaque");
+    note(count(&|m| m.get("normalTexture").is_some()), "normal maps", "surfaces are shaded by their triangles");
+    let metal = |m: &Value| {
+        let pbr = m.get("pbrMetallicRoughness");
+        number(pbr.and_then(|p| p.get("metallicFactor")), 1.0) > 0.0
+            || pbr.and_then(|p| p.get("metallicRoughnessTexture")).is_some()
+    };
+    note(count(&metal), "metalness", "surfaces are diffuse, of their base colour");
+    let glowing_texture = |m: &Value| m.get("emissiveTexture").is_some();
+    note(count(&glowing_texture), "emissive textures", "such surfaces emit their emissiveFactor evenly");
+    // A specular lobe of factor 0 (as Blender writes for a diffuse
+    // surface) is the diffuse surface Airlight renders.
+    let specular = |m: &Value| {
+        m.get("extensions")
+            .and_then(|e| e.get("KHR_materials_specular"))
+            .is_some_and(|s| number(s.get("specularFactor"), 1.0) > 0.0 || s.get("specularTexture").is_some())
+    };
+    note(count(&specular), "KHR_materials_specular", "surfaces have no specular lobe");
+    let meshes = doc.get("meshes").and_then(Value::as_array).unwrap_or(&empty);
+    let primitives = meshes.iter().filter_map(|m| m.get("primitives").and_then(Value::as_array)).flatten();
+    if primitives.clone().any(|p| p.get("attributes").and_then(|a| a.get("NORMAL")).is_some()) {
+        notes.push("vertex normals not read: surfaces are shaded flat, triangle by triangle".into());
+    }
+    let used = doc.get("extensionsUsed").and_then(Value::as_array).unwrap_or(&empty);
+    for name in used.iter().filter_map(Value::as_str) {
+        if !READ_EXTENSIONS.contains(&name) && name != "KHR_materials_specular" {
+            notes.push(format!("the extension {name} not read"));
+        }
+    }
+    notes
+}
+
 /// The glTF extensions Airlight reads (the `gltf` crate's features in
 /// Cargo.toml).
 const READ_EXTENSIONS: [&str; 2] = ["KHR_lights_punctual", "KHR_materials_emissive_strength"];
 
 /// Refuses an extension the file requires and Airlight does not read, and
-/// what the `gltf` crate (1.4) panics on rather than reporting,
-/// found by fuzzing (tests/fuzz_imports.rs): a GLB whose header gives a
-/// length below the header's own 12 bytes (a subtraction that overflows),
-/// a mesh primitive's attribute naming an accessor that does not exist
-/// (its validation indexes the accessors before it checks the index), an
-/// image in a buffer view without a `mimeType`, and an image with neither
-/// a `uri` nor a buffer view (both required by the glTF 2.0
-/// specification, read with `unwrap`). Anything else is left to
-/// the crate's own validation.
-fn before_the_crate(bytes: &[u8]) -> Result<(), String> {
+/// what the `gltf` crate (1.4) panics on rather than reporting, found by
+/// fuzzing (tests/fuzz_imports.rs): a GLB whose header gives a length below
+/// the header's own 12 bytes (a subtraction that overflows), a mesh
+/// primitive's attribute naming an accessor that does not exist (its
+/// validation indexes the accessors before it checks the index), an image
+/// in a buffer view without a `mimeType`, and an image with neither a `uri`
+/// nor a buffer view (both required by the glTF 2.0 specification, read
+/// with `unwrap`). Anything else is left to the crate's own validation.
+/// Gives the JSON document when it parses (what is not read is told from
+/// it, [`not_read`]).
+fn before_the_crate(bytes: &[u8]) -> Result<Option<serde_json::Value>, String> {
     let json = match bytes.strip_prefix(b"glTF") {
         Some(rest) => {
             let word = |at: usize| rest.get(at..at + 4).map(|w| u32::from_le_bytes([w[0], w[1], w[2], w[3]]));
@@ -343,13 +400,13 @@ fn before_the_crate(bytes: &[u8]) -> Result<(), String> {
             let length = word(8).unwrap_or(0) as usize;
             match rest.get(16..16usize.saturating_add(length)) {
                 Some(chunk) => chunk,
-                None => return Ok(()), // the crate reports a short chunk
+                None => return Ok(None), // the crate reports a short chunk
             }
         }
         None => bytes,
     };
     let Ok(doc) = serde_json::from_slice::<serde_json::Value>(json) else {
-        return Ok(()); // the crate reports what is wrong with the JSON
+        return Ok(None); // the crate reports what is wrong with the JSON
     };
     // A required extension Airlight does not read (Draco, meshopt) is the
     // one thing to say: the crate would list every accessor it leaves
@@ -390,7 +447,7 @@ fn before_the_crate(bytes: &[u8]) -> Result<(), String> {
             _ => {}
         }
     }
-    Ok(())
+    Ok(Some(doc))
 }
 
 fn wrap(mode: gltf::texture::WrappingMode) -> Wrap {
@@ -610,4 +667,40 @@ fn gltf_camera(camera: &gltf::Camera, world: Affine3A) -> Result<(Camera, Option
             (Camera::orthographic(position, position + forward, up, 2.0 * o.ymag()), Some(o.xmag() / o.ymag()))
         }
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn what_is_not_read_is_said_with_what_shows_instead() {
+        let doc = serde_json::json!({
+            "extensionsUsed": ["KHR_texture_transform", "KHR_lights_punctual", "KHR_materials_specular"],
+            "materials": [
+                // glTF's defaults: metallicFactor 1, a metal.
+                { "alphaMode": "MASK", "normalTexture": { "index": 0 } },
+                { "pbrMetallicRoughness": { "metallicFactor": 0 }, "emissiveTexture": { "index": 0 },
+                  "extensions": { "KHR_materials_specular": { "specularFactor": 0 } } },
+                { "pbrMetallicRoughness": { "metallicFactor": 0 }, "alphaMode": "OPAQUE",
+                  "extensions": { "KHR_materials_specular": {} } },
+            ],
+            "meshes": [{ "primitives": [{ "attributes": { "POSITION": 0, "NORMAL": 1 } }] }],
+        });
+        assert_eq!(
+            not_read(&doc),
+            [
+                "alphaMode MASK or BLEND (1 material) not read: cut-outs and glass are opaque",
+                "normal maps (1 material) not read: surfaces are shaded by their triangles",
+                "metalness (1 material) not read: surfaces are diffuse, of their base colour",
+                "emissive textures (1 material) not read: such surfaces emit their emissiveFactor evenly",
+                "KHR_materials_specular (1 material) not read: surfaces have no specular lobe",
+                "vertex normals not read: surfaces are shaded flat, triangle by triangle",
+                "the extension KHR_texture_transform not read",
+            ]
+        );
+        // A diffuse, opaque file without normals has nothing to say.
+        let plain = serde_json::json!({ "materials": [{ "pbrMetallicRoughness": { "metallicFactor": 0.0 } }] });
+        assert!(not_read(&plain).is_empty());
+    }
 }

@@ -25,8 +25,6 @@ pub fn parse(text: &str) -> Result<SceneDesc, SceneError> {
 /// scene lists those it read ([`Scene::files`]). The `[render]` table's
 /// integrator options are not read here (see [`crate::SceneFile`]).
 pub fn build(desc: &SceneDesc, text: &str, assets: &AssetPath) -> Result<Scene, SceneError> {
-    // The same text parsed to a spanned document: where each key and value
-    // stands, for errors found after deserializing.
     let checker = Checker::new(text, assets)?;
     let mut scene = checker.scene(desc)?;
     scene.files = checker.loader.into_files();
@@ -86,7 +84,9 @@ impl Checker<'_> {
         let mut settings = self.settings(desc)?;
         let mut included = Vec::new();
         for (i, include) in desc.include.iter().enumerate() {
-            included.push(self.include(i, include, desc)?);
+            let imported = self.include(i, include, desc)?;
+            self.notes.borrow_mut().extend(imported.notes.iter().cloned());
+            included.push(imported);
         }
         // An included camera serves when the file has none; its aspect
         // ratio sets the height when the file sets no size.

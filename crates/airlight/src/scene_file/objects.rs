@@ -119,7 +119,7 @@ impl Checker<'_> {
                 }
                 None => self.mesh_with_materials(span, &label, &d.file, transform)?,
             };
-            return Ok(Imported { parts: built, camera: None });
+            return Ok(Imported { parts: built, notes: Vec::new(), camera: None });
         }
         if !(file.ends_with(".gltf") || file.ends_with(".glb")) {
             return Err(self.err(d.file.span(), format!("{label}: `file` must be a .gltf, .glb or .obj file")));
