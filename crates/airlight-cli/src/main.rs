@@ -12,6 +12,11 @@ mod aovs;
 mod gi;
 mod load;
 mod merge;
+/// The library fuzz tests' seeded mutator, shared by the path-file and
+/// job-script fuzz tests.
+#[cfg(test)]
+#[path = "../../airlight/tests/fuzz/mutate.rs"]
+mod mutate;
 mod options;
 mod outputs;
 mod plot;

@@ -1,4 +1,4 @@
-//! Fuzzing the job scripts: 10,000 submissions with hostile names (spaces,
+//! Fuzzing the job scripts (with the library fuzzers' seeded generator): 10,000 submissions with hostile names (spaces,
 //! quotes, `$()`, backticks, `;`, `%`, newlines, backslashes, globs) for
 //! the binary, the scene, the outputs, the work folder, the render options,
 //! the partition and the time limit. Each pair of scripts that the checks
@@ -11,22 +11,7 @@
 //! `AIRLIGHT_FUZZ_INPUTS` sets the count).
 
 use super::*;
-
-/// SplitMix64, as the other fuzz tests use.
-struct Rng(u64);
-
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        z ^ (z >> 31)
-    }
-    fn below(&mut self, n: u64) -> u64 {
-        self.next() % n
-    }
-}
+use crate::mutate::Rng;
 
 /// A name a hostile user might give: plain letters mixed with what a
 /// shell or sbatch would read.
@@ -70,14 +55,14 @@ fn hostile_folder(rng: &mut Rng) -> String {
 
 fn pieces(rng: &mut Rng, pieces: &[&str]) -> String {
     let len = 1 + rng.below(6);
-    (0..len).map(|_| pieces[rng.below(pieces.len() as u64) as usize]).collect()
+    (0..len).map(|_| *rng.pick(pieces)).collect()
 }
 
 /// A partition or time limit: a valid one, or a hostile one.
 fn sbatch_value(rng: &mut Rng, valid: &[&str]) -> Option<String> {
     match rng.below(4) {
         0 => None,
-        1 | 2 => Some(valid[rng.below(valid.len() as u64) as usize].to_string()),
+        1 | 2 => Some(rng.pick(valid).to_string()),
         _ => Some(hostile(rng)),
     }
 }

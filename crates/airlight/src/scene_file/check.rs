@@ -84,8 +84,8 @@ impl Checker<'_> {
         let mut settings = self.settings(desc)?;
         let mut included = Vec::new();
         for (i, include) in desc.include.iter().enumerate() {
-            let imported = self.include(i, include, desc)?;
-            self.notes.borrow_mut().extend(imported.notes.iter().cloned());
+            let mut imported = self.include(i, include, desc)?;
+            self.notes.borrow_mut().append(&mut imported.notes);
             included.push(imported);
         }
         // An included camera serves when the file has none; its aspect
@@ -186,6 +186,16 @@ impl Checker<'_> {
     pub(super) fn direction(&self, span: Range<usize>, what: &str, v: Vec3) -> Result<Vec3> {
         let v = self.finite3(span.clone(), what, v)?;
         limits::unit(v).ok_or_else(|| self.err_field(span, what, format!("{what} must not be zero")))
+    }
+
+    /// A box's corners (a box object's, a box light's): `min` below `max`
+    /// on every axis.
+    pub(super) fn box_corners(&self, span: Range<usize>, label: &str, min: Vec3, max: Vec3) -> Result<()> {
+        if min.cmplt(max).all() {
+            return Ok(());
+        }
+        let message = format!("{label}: min must be less than max on every axis, got min {min} max {max}");
+        Err(self.err_field(span, "max", message))
     }
 
     /// A quad's edges: not parallel (in f64), and making a normal in f32.

@@ -84,13 +84,7 @@ impl<'a> Checker<'a> {
             }
             LightDesc::Box(l) => {
                 let (min, max) = (point(l.min, "min")?, point(l.max, "max")?);
-                if !min.cmplt(max).all() {
-                    return Err(self.err_field(
-                        span,
-                        "max",
-                        format!("{label}: min must be less than max on every axis, got min {min} max {max}"),
-                    ));
-                }
+                self.box_corners(span.clone(), label, min, max)?;
                 return Ok(Light::volume_box(min, max, power(l.intensity, "intensity")?));
             }
         };

@@ -47,13 +47,7 @@ impl Checker<'_> {
             }
             ObjectDesc::Box(b) => {
                 let (min, max) = (get(b.min, "min")?, get(b.max, "max")?);
-                if !min.cmplt(max).all() {
-                    return Err(self.err_field(
-                        span,
-                        "max",
-                        format!("{label}: min must be less than max on every axis, got min {min} max {max}"),
-                    ));
-                }
+                self.box_corners(span.clone(), &label, min, max)?;
                 Shape::cuboid(min, max)
             }
             ObjectDesc::Mesh(mesh) => self.mesh(&label, &mesh.file)?,

@@ -8,11 +8,8 @@
 //! (`cargo test --release -p airlight-cli -- --ignored path_files`);
 //! `AIRLIGHT_FUZZ_INPUTS` sets the count, `AIRLIGHT_FUZZ_SEED` replays one.
 
-#[path = "../../../../airlight/tests/fuzz/mutate.rs"]
-mod mutate;
-
 use super::*;
-use mutate::{Rng, mutate_text, mutate_tree};
+use crate::mutate::{self, Rng, mutate_text, mutate_tree};
 use std::panic::{AssertUnwindSafe, catch_unwind};
 
 const NAMES: &[&str] = &[
