@@ -57,6 +57,12 @@ pub fn srgb_to_linear(c: f32) -> f32 {
     if c <= 0.04045 { c / 12.92 } else { ((c + 0.055) / 1.055).powf(2.4) }
 }
 
+/// Each byte over 255, for textures that hold data.
+fn data_table() -> &'static [f32; 256] {
+    static TABLE: std::sync::OnceLock<[f32; 256]> = std::sync::OnceLock::new();
+    TABLE.get_or_init(|| std::array::from_fn(|i| i as f32 / 255.0))
+}
+
 /// The linear value of each 8-bit sRGB code.
 fn decode_table() -> &'static [f32; 256] {
     static TABLE: std::sync::OnceLock<[f32; 256]> = std::sync::OnceLock::new();
@@ -72,6 +78,9 @@ pub struct Texture {
     texels: Vec<[u8; 3]>,
     wrap_u: Wrap,
     wrap_v: Wrap,
+    /// Whether the bytes are data (glTF's metallic-roughness maps: the
+    /// byte over 255) rather than sRGB-encoded colour.
+    linear: bool,
     /// The mean linear colour, for surfaces without texture coordinates.
     mean: Rgb,
 }
@@ -82,6 +91,7 @@ impl std::fmt::Debug for Texture {
             .field("width", &self.width)
             .field("height", &self.height)
             .field("wrap", &(self.wrap_u, self.wrap_v))
+            .field("linear", &self.linear)
             .field("mean", &self.mean)
             // The texels themselves, so that the debug text (a render's
             // fingerprint) changes with any of them, not only with the mean.
@@ -102,12 +112,37 @@ impl Texture {
         if width == 0 || height == 0 || texels.len() as u64 != width as u64 * height as u64 {
             return None;
         }
-        let table = decode_table();
-        let sum = texels.iter().fold(glam::DVec3::ZERO, |s, t| {
+        let mut texture = Texture {
+            width,
+            height,
+            texels,
+            wrap_u: Wrap::Repeat,
+            wrap_v: Wrap::Repeat,
+            linear: false,
+            mean: Rgb::ZERO,
+        };
+        texture.mean = texture.texel_mean();
+        Some(texture)
+    }
+
+    /// The same texels read as data, each byte over 255, not as sRGB
+    /// colour: glTF's metallic-roughness maps hold numbers, not colours.
+    pub fn as_data(mut self) -> Texture {
+        self.linear = true;
+        self.mean = self.texel_mean();
+        self
+    }
+
+    fn table(&self) -> &'static [f32; 256] {
+        if self.linear { data_table() } else { decode_table() }
+    }
+
+    fn texel_mean(&self) -> Rgb {
+        let table = self.table();
+        let sum = self.texels.iter().fold(glam::DVec3::ZERO, |s, t| {
             s + glam::DVec3::new(table[t[0] as usize] as f64, table[t[1] as usize] as f64, table[t[2] as usize] as f64)
         });
-        let mean = (sum / texels.len() as f64).as_vec3();
-        Some(Texture { width, height, texels, wrap_u: Wrap::Repeat, wrap_v: Wrap::Repeat, mean })
+        (sum / self.texels.len() as f64).as_vec3()
     }
 
     /// Decodes a PNG or JPEG image; alpha is dropped and 16-bit channels
@@ -161,7 +196,7 @@ impl Texture {
     fn texel(&self, x: i64, y: i64) -> Rgb {
         let (x, y) = (self.wrap_u.index(x, self.width), self.wrap_v.index(y, self.height));
         let t = self.texels[y * self.width as usize + x];
-        let table = decode_table();
+        let table = self.table();
         Rgb::new(table[t[0] as usize], table[t[1] as usize], table[t[2] as usize])
     }
 

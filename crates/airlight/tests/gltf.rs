@@ -82,7 +82,8 @@ fn gltf_json(buffer_uri: Option<&str>, extra_required: &str, lamp_mode: u32) -> 
     )
 }
 
-/// The same room by hand: the floor ±2 at y = 0, the lamp ±0.5 at y = 1.5
+/// The same room by hand: the floor ±2 at y = 0 a rough metal (glTF's
+/// default factors), the lamp ±0.5 at y = 1.5
 /// facing down with radiance [6, 5, 4], a point light of 1366 cd × colour
 /// over 683 lm/W, and the camera 60° high looking along +z.
 const BY_HAND: &str = r#"
@@ -94,7 +95,10 @@ position = [0.3, 1, -3]
 look_at = [0.3, 1, 0]
 fov = 60
 [materials.red]
-albedo = [0.6, 0.2, 0.1]
+type = "metallic_roughness"
+base_colour = [0.6, 0.2, 0.1]
+metallic = 1
+roughness = 1
 [[objects]]
 type = "quad"
 corner = [-2, 0, -2]

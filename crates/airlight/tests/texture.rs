@@ -137,8 +137,15 @@ fn an_obj_map_kd_with_texture_coordinates() {
 }
 
 /// The square as glTF: positions, TEXCOORD_0 and indices in a data-URI
-/// buffer; the image a file, a data URI, or a buffer view.
+/// buffer; the image a file, a data URI, or a buffer view. Its material is
+/// diffuse (no metalness, no specular lobe: `KHR_materials_specular`'s
+/// factor 0), so that the image shows the texture.
 fn gltf(image: &str, sampler: &str, attributes: &str) -> String {
+    gltf_with(image, sampler, attributes, "")
+}
+
+/// The same with `extra` in the base colour texture's `textureInfo`.
+fn gltf_with(image: &str, sampler: &str, attributes: &str, extra: &str) -> String {
     let mut data = Vec::new();
     for p in [[0.0f32, 0.0, 0.0], [2.0, 0.0, 0.0], [2.0, 2.0, 0.0], [0.0, 2.0, 0.0]] {
         p.iter().for_each(|x| data.extend_from_slice(&x.to_le_bytes()));
@@ -159,7 +166,9 @@ fn gltf(image: &str, sampler: &str, attributes: &str) -> String {
   "scenes": [{{ "nodes": [0] }}],
   "nodes": [{{ "mesh": 0 }}],
   "meshes": [{{ "primitives": [{{ "attributes": {{ {attributes} }}, "indices": 2, "material": 0 }}] }}],
-  "materials": [{{ "pbrMetallicRoughness": {{ "baseColorFactor": [1, 0.5, 0.5, 1], "baseColorTexture": {{ "index": 0 }} }} }}],
+  "materials": [{{ "pbrMetallicRoughness": {{ "baseColorFactor": [1, 0.5, 0.5, 1], "metallicFactor": 0,
+                     "baseColorTexture": {{ "index": 0 {extra} }} }},
+                  "extensions": {{ "KHR_materials_specular": {{ "specularFactor": 0 }} }} }}],
   "textures": [{{ "source": 0 {sampler} }}],
   "samplers": [{{ "wrapS": 33071, "wrapT": 33071 }}],
   "images": [{image}],
@@ -211,9 +220,31 @@ fn a_gltf_base_colour_texture_with_its_sampler() {
     assert!(e.contains("textures[0] → images[0]: a Gif image; textures are PNG or JPEG"), "{e}");
     let e = error(r#"{ "uri": "tex.png" }"#, r#""POSITION": 0"#);
     assert!(
-        e.contains(
-            "meshes[0].primitives[0]: its material's base-colour texture uses TEXCOORD_0, which it does not have"
-        ),
+        e.contains("meshes[0].primitives[0]: its material's textures use TEXCOORD_0, which it does not have"),
         "{e}"
     );
+}
+
+/// `KHR_texture_transform` on the base colour texture: scale −1 and
+/// offset 1 along u mirror the image left to right, and a transform's
+/// `texCoord` picks the coordinate set it names.
+#[test]
+fn a_gltf_texture_transform_moves_the_image() {
+    let dir = folder();
+    let text = format!("{VIEW}\n[[include]]\nfile = \"sq.gltf\"\n");
+    let mirror = r#", "extensions": { "KHR_texture_transform": { "offset": [1, 0], "scale": [-1, 1] } }"#;
+    std::fs::write(
+        dir.path().join("sq.gltf"),
+        gltf_with(r#"{ "uri": "tex.png" }"#, r#", "sampler": 0"#, ATTRIBUTES, mirror),
+    )
+    .unwrap();
+    let image = render(&text, dir.path());
+    let mirrored: Vec<Vec<Vec3>> = image.iter().map(|row| row.iter().rev().copied().collect()).collect();
+    check("mirrored by its transform", &mirrored, true, Vec3::new(1.0, 0.5, 0.5));
+    // The transform names TEXCOORD_1, which the primitive lacks: said so.
+    let other_set = r#", "extensions": { "KHR_texture_transform": { "texCoord": 1 } }"#;
+    std::fs::write(dir.path().join("sq.gltf"), gltf_with(r#"{ "uri": "tex.png" }"#, "", ATTRIBUTES, other_set))
+        .unwrap();
+    let e = SceneFile::from_toml_str(&text, Some(dir.path())).unwrap_err().to_string();
+    assert!(e.contains("its material's textures use TEXCOORD_1, which it does not have"), "{e}");
 }

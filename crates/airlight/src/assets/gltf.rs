@@ -14,7 +14,7 @@ use super::{Loader, MAX_MESH_BYTES, read_limited};
 use crate::camera::Camera;
 use crate::geometry::Shape;
 use crate::light::{Attenuation, Light, SpotProfile};
-use crate::material::Material;
+use crate::material::{Material, MetallicRoughness, SurfaceMaps, TextureMap, UvTransform};
 use crate::scene::{Parts, limits};
 use crate::texture::{Texture, Wrap};
 use base64::Engine;
@@ -227,35 +227,20 @@ impl Loader<'_> {
                 out.parts.lights.extend(Light::triangles_of(&positions, &triangles, emission));
                 continue;
             }
-            let base_colour = material.pbr_metallic_roughness().base_color_texture();
             let mut uvs = Vec::new();
             let name = match include.material {
                 Some(name) => name.to_string(),
                 None => {
-                    let [r, g, b, _] = material.pbr_metallic_roughness().base_color_factor();
                     let name = match material.index() {
                         Some(i) => format!("{}#materials[{i}]", include.file),
                         None => format!("{}#default", include.file),
                     };
-                    if let Some(info) = &base_colour {
-                        uvs = texture_coordinates(&primitive, info.tex_coord(), positions.len(), buffers)
+                    if let Some(set) = uv_set(&material) {
+                        uvs = texture_coordinates(&primitive, set, positions.len(), buffers)
                             .map_err(|why| format!("{at}: {why}"))?;
                     }
                     if !out.parts.materials.iter().any(|(n, _)| *n == name) {
-                        let albedo = Vec3::new(r, g, b);
-                        if !(albedo.is_finite() && albedo.min_element() >= 0.0) {
-                            return Err(format!("{at}: its base colour is not finite and ≥ 0: {albedo}"));
-                        }
-                        let m = match &base_colour {
-                            Some(info) => {
-                                let i = material.index().unwrap_or(0);
-                                let texture = self.gltf_texture(textures, &info.texture()).map_err(|why| {
-                                    format!("materials[{i}].pbrMetallicRoughness.baseColorTexture: {why}")
-                                })?;
-                                Material::textured(albedo, texture)
-                            }
-                            None => Material::diffuse(albedo),
-                        };
+                        let m = self.gltf_material(&material, textures)?;
                         out.parts.materials.push((name.clone(), m));
                     }
                     name
@@ -267,21 +252,122 @@ impl Loader<'_> {
     }
 }
 
+/// The texture coordinate set a material's maps read: its base colour
+/// texture's, or else its metallic-roughness texture's (a
+/// `KHR_texture_transform` may name another). Meshes carry one set;
+/// [`not_read`] says so when a material's maps ask for two.
+fn uv_set(material: &gltf::Material) -> Option<u32> {
+    let pbr = material.pbr_metallic_roughness();
+    let set =
+        |info: gltf::texture::Info| info.texture_transform().and_then(|t| t.tex_coord()).unwrap_or(info.tex_coord());
+    pbr.base_color_texture().map(set).or_else(|| pbr.metallic_roughness_texture().map(set))
+}
+
+impl Loader<'_> {
+    /// A glTF material as Airlight's: metallic-roughness with its maps,
+    /// or, when it has no specular reflection at all (metallic 0 and
+    /// `KHR_materials_specular`'s factor 0, as Blender writes a diffuse
+    /// surface) the Lambertian material it then is, which the integrators
+    /// treat faster.
+    fn gltf_material(&self, material: &gltf::Material, textures: &mut Textures) -> Result<Material, String> {
+        let at = material.index().map_or("the default material".to_string(), |i| format!("materials[{i}]"));
+        self.gltf_material_at(material, textures, &at)
+    }
+
+    fn gltf_material_at(
+        &self,
+        material: &gltf::Material,
+        textures: &mut Textures,
+        at: &str,
+    ) -> Result<Material, String> {
+        let pbr = material.pbr_metallic_roughness();
+        let [r, g, b, _] = pbr.base_color_factor();
+        let base = Vec3::new(r, g, b);
+        if !(base.is_finite() && base.min_element() >= 0.0) {
+            return Err(format!("{at}: its base colour is not finite and ≥ 0: {base}"));
+        }
+        let unit = |v: f32, what: &str| {
+            if (0.0..=1.0).contains(&v) { Ok(v) } else { Err(format!("{at}: its {what} is {v}, not in [0, 1]")) }
+        };
+        let metallic = unit(pbr.metallic_factor(), "metallicFactor")?;
+        let roughness = unit(pbr.roughness_factor(), "roughnessFactor")?;
+        let specular = unit(material.specular().map_or(1.0, |s| s.specular_factor()), "specularFactor")?;
+        let mut map = |info: Option<gltf::texture::Info>,
+                       what: &str,
+                       data: bool|
+         -> Result<Option<TextureMap>, String> {
+            let Some(info) = info else { return Ok(None) };
+            let texture =
+                self.gltf_texture(textures, &info.texture(), data).map_err(|why| format!("{at}.{what}: {why}"))?;
+            let transform = match info.texture_transform() {
+                Some(t) => {
+                    let transform = UvTransform {
+                        offset: Vec2::from_array(t.offset()),
+                        rotation: t.rotation(),
+                        scale: Vec2::from_array(t.scale()),
+                    };
+                    if !(transform.offset.is_finite() && transform.rotation.is_finite() && transform.scale.is_finite())
+                    {
+                        return Err(format!("{at}.{what}: its KHR_texture_transform is not finite"));
+                    }
+                    transform
+                }
+                None => UvTransform::IDENTITY,
+            };
+            Ok(Some(TextureMap { texture, transform }))
+        };
+        let maps = SurfaceMaps {
+            base_colour: map(pbr.base_color_texture(), "pbrMetallicRoughness.baseColorTexture", false)?,
+            metallic_roughness: map(
+                pbr.metallic_roughness_texture(),
+                "pbrMetallicRoughness.metallicRoughnessTexture",
+                true,
+            )?,
+        };
+        if metallic == 0.0 && specular == 0.0 && maps.metallic_roughness.is_none() {
+            return Ok(match maps.base_colour {
+                Some(m) if m.transform == UvTransform::IDENTITY => Material::textured(base, m.texture),
+                Some(m) => {
+                    let maps = SurfaceMaps { base_colour: Some(m), metallic_roughness: None };
+                    let lambertian = MetallicRoughness::lambertian(base);
+                    Material::MetallicRoughness(MetallicRoughness { maps: Some(Arc::new(maps)), ..lambertian })
+                }
+                None => Material::diffuse(base),
+            });
+        }
+        let has_maps = maps.base_colour.is_some() || maps.metallic_roughness.is_some();
+        Ok(Material::MetallicRoughness(MetallicRoughness {
+            base,
+            metallic,
+            roughness,
+            specular,
+            maps: has_maps.then(|| Arc::new(maps)),
+        }))
+    }
+}
+
 /// The glTF file's images, read once each, and what they are read from.
 struct Textures<'a> {
     /// The glTF file's name in the scene (images in files lie beside it).
     file: &'a Path,
     buffers: &'a [Vec<u8>],
-    /// By texture index: an image with its sampler's wrap modes.
-    read: HashMap<usize, Arc<Texture>>,
+    /// By texture index and whether read as data: an image with its
+    /// sampler's wrap modes.
+    read: HashMap<(usize, bool), Arc<Texture>>,
 }
 
 impl Loader<'_> {
     /// A glTF texture: its image (a file beside the glTF file under the
     /// asset rules, a data URI, or a buffer view), decoded to sRGB texels,
-    /// with its sampler's wrap modes; read once per texture.
-    fn gltf_texture(&self, textures: &mut Textures, texture: &gltf::Texture) -> Result<Arc<Texture>, String> {
-        if let Some(t) = textures.read.get(&texture.index()) {
+    /// with its sampler's wrap modes, as colour or (`data`) as numbers;
+    /// read once per texture and use.
+    fn gltf_texture(
+        &self,
+        textures: &mut Textures,
+        texture: &gltf::Texture,
+        data: bool,
+    ) -> Result<Arc<Texture>, String> {
+        if let Some(t) = textures.read.get(&(texture.index(), data)) {
             return Ok(t.clone());
         }
         let image = texture.source();
@@ -313,8 +399,9 @@ impl Loader<'_> {
         };
         let decoded = self.texture_bytes(&bytes, &at).map_err(|why| format!("{at}: {why}"))?;
         let sampler = texture.sampler();
-        let texture_arc = Arc::new(decoded.with_wrap(wrap(sampler.wrap_s()), wrap(sampler.wrap_t())));
-        textures.read.insert(texture.index(), texture_arc.clone());
+        let decoded = decoded.with_wrap(wrap(sampler.wrap_s()), wrap(sampler.wrap_t()));
+        let texture_arc = Arc::new(if data { decoded.as_data() } else { decoded });
+        textures.read.insert((texture.index(), data), texture_arc.clone());
         Ok(texture_arc)
     }
 }
@@ -340,22 +427,29 @@ fn not_read(doc: &serde_json::Value) -> Vec<String> {
     let cut_out = |m: &Value| m.get("alphaMode").and_then(Value::as_str).is_some_and(|a| a != "OPAQUE");
     note(count(&cut_out), "alphaMode MASK or BLEND", "cut-outs and glass are opaque");
     note(count(&|m| m.get("normalTexture").is_some()), "normal maps", "surfaces are shaded by their triangles");
-    let metal = |m: &Value| {
-        let pbr = m.get("pbrMetallicRoughness");
-        number(pbr.and_then(|p| p.get("metallicFactor")), 1.0) > 0.0
-            || pbr.and_then(|p| p.get("metallicRoughnessTexture")).is_some()
-    };
-    note(count(&metal), "metalness", "surfaces are diffuse, of their base colour");
     let glowing_texture = |m: &Value| m.get("emissiveTexture").is_some();
     note(count(&glowing_texture), "emissive textures", "such surfaces emit their emissiveFactor evenly");
-    // A specular lobe of factor 0 (as Blender writes for a diffuse
-    // surface) is the diffuse surface Airlight renders.
+    // KHR_materials_specular's factor is read; its colour and textures not.
     let specular = |m: &Value| {
-        m.get("extensions")
-            .and_then(|e| e.get("KHR_materials_specular"))
-            .is_some_and(|s| number(s.get("specularFactor"), 1.0) > 0.0 || s.get("specularTexture").is_some())
+        m.get("extensions").and_then(|e| e.get("KHR_materials_specular")).is_some_and(|s| {
+            ["specularTexture", "specularColorFactor", "specularColorTexture"].iter().any(|k| s.get(k).is_some())
+        })
     };
-    note(count(&specular), "KHR_materials_specular", "surfaces have no specular lobe");
+    note(count(&specular), "KHR_materials_specular colours and textures", "only its specularFactor weighs the lobe");
+    let set = |info: Option<&Value>| {
+        let info = info?;
+        let moved = info.get("extensions").and_then(|e| e.get("KHR_texture_transform")).and_then(|t| t.get("texCoord"));
+        Some(number(moved.or(info.get("texCoord")), 0.0))
+    };
+    let two_sets = |m: &Value| {
+        let pbr = m.get("pbrMetallicRoughness");
+        let (a, b) = (
+            set(pbr.and_then(|p| p.get("baseColorTexture"))),
+            set(pbr.and_then(|p| p.get("metallicRoughnessTexture"))),
+        );
+        a.zip(b).is_some_and(|(a, b)| a != b)
+    };
+    note(count(&two_sets), "a second texture coordinate set", "the metallic-roughness map reads the base colour's");
     let meshes = doc.get("meshes").and_then(Value::as_array).unwrap_or(&empty);
     let primitives = meshes.iter().filter_map(|m| m.get("primitives").and_then(Value::as_array)).flatten();
     if primitives.clone().any(|p| p.get("attributes").and_then(|a| a.get("NORMAL")).is_some()) {
@@ -363,7 +457,7 @@ fn not_read(doc: &serde_json::Value) -> Vec<String> {
     }
     let used = doc.get("extensionsUsed").and_then(Value::as_array).unwrap_or(&empty);
     for name in used.iter().filter_map(Value::as_str) {
-        if !READ_EXTENSIONS.contains(&name) && name != "KHR_materials_specular" {
+        if !READ_EXTENSIONS.contains(&name) {
             notes.push(format!("the extension {name} not read"));
         }
     }
@@ -372,7 +466,8 @@ fn not_read(doc: &serde_json::Value) -> Vec<String> {
 
 /// The glTF extensions Airlight reads (the `gltf` crate's features in
 /// Cargo.toml).
-const READ_EXTENSIONS: [&str; 2] = ["KHR_lights_punctual", "KHR_materials_emissive_strength"];
+const READ_EXTENSIONS: [&str; 4] =
+    ["KHR_lights_punctual", "KHR_materials_emissive_strength", "KHR_materials_specular", "KHR_texture_transform"];
 
 /// Refuses an extension the file requires and Airlight does not read, and
 /// what the `gltf` crate (1.4) panics on rather than reporting, found by
@@ -488,7 +583,7 @@ fn texture_coordinates(
 ) -> Result<Vec<Vec2>, String> {
     let accessor = primitive
         .get(&gltf::Semantic::TexCoords(set))
-        .ok_or_else(|| format!("its material's base-colour texture uses TEXCOORD_{set}, which it does not have"))?;
+        .ok_or_else(|| format!("its material's textures use TEXCOORD_{set}, which it does not have"))?;
     use gltf::accessor::{DataType, Dimensions};
     typed(&accessor, Dimensions::Vec2, &[DataType::F32, DataType::U8, DataType::U16])
         .and_then(|()| fits(&accessor, buffers))
@@ -676,14 +771,15 @@ mod tests {
     #[test]
     fn what_is_not_read_is_said_with_what_shows_instead() {
         let doc = serde_json::json!({
-            "extensionsUsed": ["KHR_texture_transform", "KHR_lights_punctual", "KHR_materials_specular"],
+            "extensionsUsed": ["KHR_texture_transform", "KHR_lights_punctual", "KHR_materials_sheen"],
             "materials": [
-                // glTF's defaults: metallicFactor 1, a metal.
                 { "alphaMode": "MASK", "normalTexture": { "index": 0 } },
                 { "pbrMetallicRoughness": { "metallicFactor": 0 }, "emissiveTexture": { "index": 0 },
                   "extensions": { "KHR_materials_specular": { "specularFactor": 0 } } },
-                { "pbrMetallicRoughness": { "metallicFactor": 0 }, "alphaMode": "OPAQUE",
-                  "extensions": { "KHR_materials_specular": {} } },
+                { "pbrMetallicRoughness": { "metallicFactor": 0, "baseColorTexture": { "index": 0 },
+                    "metallicRoughnessTexture": { "index": 1, "extensions": { "KHR_texture_transform": { "texCoord": 1 } } } },
+                  "alphaMode": "OPAQUE",
+                  "extensions": { "KHR_materials_specular": { "specularColorFactor": [1, 0, 0] } } },
             ],
             "meshes": [{ "primitives": [{ "attributes": { "POSITION": 0, "NORMAL": 1 } }] }],
         });
@@ -692,15 +788,15 @@ mod tests {
             [
                 "alphaMode MASK or BLEND (1 material) not read: cut-outs and glass are opaque",
                 "normal maps (1 material) not read: surfaces are shaded by their triangles",
-                "metalness (1 material) not read: surfaces are diffuse, of their base colour",
                 "emissive textures (1 material) not read: such surfaces emit their emissiveFactor evenly",
-                "KHR_materials_specular (1 material) not read: surfaces have no specular lobe",
+                "KHR_materials_specular colours and textures (1 material) not read: only its specularFactor weighs the lobe",
+                "a second texture coordinate set (1 material) not read: the metallic-roughness map reads the base colour's",
                 "vertex normals not read: surfaces are shaded flat, triangle by triangle",
-                "the extension KHR_texture_transform not read",
+                "the extension KHR_materials_sheen not read",
             ]
         );
-        // A diffuse, opaque file without normals has nothing to say.
-        let plain = serde_json::json!({ "materials": [{ "pbrMetallicRoughness": { "metallicFactor": 0.0 } }] });
+        // A metallic-roughness, opaque file without normals has nothing to say.
+        let plain = serde_json::json!({ "materials": [{ "pbrMetallicRoughness": { "metallicFactor": 0.5 } }] });
         assert!(not_read(&plain).is_empty());
     }
 }

@@ -124,10 +124,7 @@ impl Scene {
     #[inline]
     pub fn material_at(&self, surface: &SurfaceHit) -> Material {
         let material = self.material(surface.material);
-        match material {
-            Material::Textured { .. } => material.at_uv(self.geometry.uv(surface)),
-            _ => material.clone(),
-        }
+        if material.has_maps() { material.at_uv(self.geometry.uv(surface)) } else { material.clone() }
     }
 
     pub fn lights(&self) -> &[Light] {

@@ -178,6 +178,7 @@ tagged! {
         Checker(CheckerMaterial) = "checker",
         Phong(PhongMaterial) = "phong",
         Texture(TextureMaterial) = "texture",
+        MetallicRoughness(MetallicRoughnessMaterial) = "metallic_roughness",
     }
 }
 
@@ -210,6 +211,23 @@ pub(crate) struct TextureMaterial {
     pub albedo: Option<Triple>,
     pub file: Spanned<String>,
     /// `repeat`, `clamp` or `mirror`.
+    pub wrap: Option<Spanned<String>>,
+}
+
+/// glTF 2.0's metallic-roughness material, its factors and optional maps.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct MetallicRoughnessMaterial {
+    pub base_colour: Option<Triple>,
+    pub metallic: Option<Spanned<f32>>,
+    pub roughness: Option<Spanned<f32>>,
+    /// The dielectric's specular weight (glTF's `KHR_materials_specular`).
+    pub specular: Option<Spanned<f32>>,
+    /// An sRGB image that multiplies `base_colour`.
+    pub base_colour_file: Option<Spanned<String>>,
+    /// Data: green multiplies `roughness`, blue `metallic`.
+    pub metallic_roughness_file: Option<Spanned<String>>,
+    /// `repeat`, `clamp` or `mirror`, for both images.
     pub wrap: Option<Spanned<String>>,
 }
 

@@ -3,8 +3,11 @@
 use super::check::{Checker, Result};
 use super::desc::{self, MaterialDesc, Triple};
 use crate::Rgb;
-use crate::material::Material;
+use crate::material::{Material, MetallicRoughness, SurfaceMaps, TextureMap};
+use crate::texture::Texture;
 use glam::Vec3;
+use std::sync::Arc;
+use toml::Spanned;
 
 impl Checker<'_> {
     /// The material `[materials.NAME]` describes, read by its type.
@@ -29,19 +32,64 @@ impl Checker<'_> {
             }
             MaterialDesc::Texture(m) => {
                 let factor = albedo(m.albedo, "albedo", 1.0)?;
-                let texture = self
-                    .loader
-                    .texture_file(m.file.get_ref())
-                    .map_err(|why| self.err(m.file.span(), format!("{label}.file: cannot load the texture: {why}")))?;
-                let texture = match &m.wrap {
-                    Some(w) => {
-                        let wrap = desc::parse_name(w, &what("wrap")).map_err(|e| self.err(e.span, e.message))?;
-                        std::sync::Arc::new((*texture).clone().with_wrap(wrap, wrap))
+                Material::textured(factor, self.image(&label, "file", &m.file, m.wrap.as_ref(), false)?)
+            }
+            MaterialDesc::MetallicRoughness(m) => {
+                let base = albedo(m.base_colour, "base_colour", 0.8)?;
+                let unit = |v: &Option<Spanned<f32>>, field: &str, default: f32| -> Result<f32> {
+                    let Some(v) = v else { return Ok(default) };
+                    if (0.0..=1.0).contains(v.get_ref()) {
+                        Ok(*v.get_ref())
+                    } else {
+                        Err(self.err(
+                            v.span(),
+                            format!("{}: expected a number in [0, 1], got {}", what(field), v.get_ref()),
+                        ))
                     }
-                    None => texture,
                 };
-                Material::textured(factor, texture)
+                let image = |file: &Option<Spanned<String>>, field: &str, data: bool| -> Result<Option<TextureMap>> {
+                    file.as_ref()
+                        .map(|f| self.image(&label, field, f, m.wrap.as_ref(), data).map(TextureMap::new))
+                        .transpose()
+                };
+                let maps = SurfaceMaps {
+                    base_colour: image(&m.base_colour_file, "base_colour_file", false)?,
+                    metallic_roughness: image(&m.metallic_roughness_file, "metallic_roughness_file", true)?,
+                };
+                let has_maps = maps.base_colour.is_some() || maps.metallic_roughness.is_some();
+                Material::MetallicRoughness(MetallicRoughness {
+                    base,
+                    metallic: unit(&m.metallic, "metallic", 0.0)?,
+                    roughness: unit(&m.roughness, "roughness", 0.5)?,
+                    specular: unit(&m.specular, "specular", 1.0)?,
+                    maps: has_maps.then(|| Arc::new(maps)),
+                })
             }
         })
+    }
+
+    /// An image a material names in `field`, with its wrap mode; read as
+    /// data rather than sRGB colour when `data`.
+    fn image(
+        &self,
+        label: &str,
+        field: &str,
+        file: &Spanned<String>,
+        wrap: Option<&Spanned<String>>,
+        data: bool,
+    ) -> Result<Arc<Texture>> {
+        let texture = self
+            .loader
+            .texture_file(file.get_ref())
+            .map_err(|why| self.err(file.span(), format!("{label}.{field}: cannot load the texture: {why}")))?;
+        if wrap.is_none() && !data {
+            return Ok(texture);
+        }
+        let mut texture = (*texture).clone();
+        if let Some(w) = wrap {
+            let wrap = desc::parse_name(w, &format!("{label}.wrap")).map_err(|e| self.err(e.span, e.message))?;
+            texture = texture.with_wrap(wrap, wrap);
+        }
+        Ok(Arc::new(if data { texture.as_data() } else { texture }))
     }
 }

@@ -1,5 +1,10 @@
 //! Surface materials. All reflect on both sides (docs/scene-format.md: two-sided).
 
+pub mod metallic_roughness;
+pub mod microfacet;
+
+pub use metallic_roughness::{MetallicRoughness, SurfaceMaps, TextureMap, UvTransform};
+
 use crate::Rgb;
 use crate::texture::Texture;
 use glam::Vec3;
@@ -23,6 +28,9 @@ pub enum Material {
     /// without texture coordinates (a sphere, a mesh without them) takes
     /// `factor` × the texture's mean colour.
     Textured { factor: Rgb, texture: Arc<Texture> },
+    /// glTF 2.0's metallic-roughness material: GGX over Lambert
+    /// ([`MetallicRoughness`]).
+    MetallicRoughness(MetallicRoughness),
 }
 
 impl Material {
@@ -49,15 +57,27 @@ impl Material {
             (Material::Textured { factor, texture }, Some(uv)) => {
                 Material::Diffuse { albedo: *factor * texture.sample(uv.x, uv.y) }
             }
+            (Material::MetallicRoughness(m), _) => Material::MetallicRoughness(m.at_uv(uv)),
             _ => self.clone(),
         }
     }
 
+    /// Whether [`Material::at_uv`] depends on the texture coordinates.
+    pub fn has_maps(&self) -> bool {
+        match self {
+            Material::Textured { .. } => true,
+            Material::MetallicRoughness(m) => m.maps.is_some(),
+            _ => false,
+        }
+    }
+
     /// The diffuse albedo at point `p` with outward normal `n` (a textured
-    /// material: its mean; see [`Material::at_uv`]).
+    /// material: its mean; see [`Material::at_uv`]; a metallic-roughness
+    /// one: its diffuse stand-in, [`MetallicRoughness::albedo`]).
     pub fn albedo(&self, p: Vec3, n: Vec3) -> Rgb {
         match *self {
             Material::Textured { factor, ref texture } => factor * texture.mean(),
+            Material::MetallicRoughness(ref m) => m.at_uv(None).albedo(),
             Material::Diffuse { albedo } | Material::Phong { albedo, .. } => albedo,
             Material::Checker { albedo, albedo2, scale } => {
                 // Step half a square inward so that points on a face that lies
@@ -76,7 +96,7 @@ impl Material {
     #[inline]
     pub fn lambertian_brdf(&self, p: Vec3, n: Vec3) -> Option<Rgb> {
         match self {
-            Material::Phong { .. } => None,
+            Material::Phong { .. } | Material::MetallicRoughness(_) => None,
             _ => Some(self.diffuse_brdf(p, n)),
         }
     }
@@ -94,6 +114,9 @@ impl Material {
     pub fn brdf(&self, p: Vec3, n: Vec3, wo: Vec3, wi: Vec3) -> Rgb {
         if n.dot(wo) * n.dot(wi) <= 0.0 {
             return Rgb::ZERO;
+        }
+        if let Material::MetallicRoughness(m) = self {
+            return m.eval(n, wo, wi).0;
         }
         let diffuse = self.diffuse_brdf(p, n);
         match *self {
@@ -149,11 +172,17 @@ impl Material {
             let cos = if cos_o < 0.0 { -cos_i } else { cos_i };
             return (f, if cos > 0.0 { cos / PI } else { 0.0 });
         }
+        if let Material::MetallicRoughness(m) = self {
+            return m.eval(n, wo, wi);
+        }
         (self.brdf(p, n, wo, wi), self.pdf(p, n, wo, wi))
     }
 
     /// Solid-angle pdf with which [`Material::sample`] draws `wi`.
     pub fn pdf(&self, p: Vec3, n: Vec3, wo: Vec3, wi: Vec3) -> f32 {
+        if let Material::MetallicRoughness(m) = self {
+            return m.eval(n, wo, wi).1;
+        }
         // Directions are drawn on wo's side; `n` itself still picks the
         // checker's square.
         let facing = if n.dot(wo) < 0.0 { -n } else { n };
@@ -190,6 +219,9 @@ impl Material {
             }
             let f = if n.dot(wo) * n.dot(wi) > 0.0 { albedo / PI } else { Rgb::ZERO };
             return Some(BsdfSample { wi, f, pdf: cos / PI });
+        }
+        if let Material::MetallicRoughness(m) = self {
+            return m.sample(n, wo, u, u_lobe).map(|(wi, f, pdf)| BsdfSample { wi, f, pdf });
         }
         let wi = if u_lobe < self.lobe_probability(p, n) {
             let Material::Phong { exponent, .. } = *self else { unreachable!() };
