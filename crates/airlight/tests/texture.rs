@@ -248,3 +248,35 @@ fn a_gltf_texture_transform_moves_the_image() {
     let e = SceneFile::from_toml_str(&text, Some(dir.path())).unwrap_err().to_string();
     assert!(e.contains("its material's textures use TEXCOORD_1, which it does not have"), "{e}");
 }
+
+/// An emissive texture: each triangle glows with the factor × strength ×
+/// the texture's mean over it, and a triangle where it is black is no
+/// light but a surface of its material.
+#[test]
+fn a_gltf_emissive_texture_sets_each_triangles_radiance() {
+    let dir = folder();
+    let text = format!("{VIEW}\n[[include]]\nfile = \"sq.gltf\"\n");
+    let emissive = r#""emissiveFactor": [1, 0.5, 0.25], "emissiveTexture": { "index": 0 },
+                  "extensions": { "KHR_materials_emissive_strength": { "emissiveStrength": 4 },"#;
+    for (code, lights) in [(128u8, 2), (0, 0)] {
+        std::fs::write(dir.path().join("one.png"), png(&[[code; 3]], 1, 1)).unwrap();
+        let json = gltf(r#"{ "uri": "one.png" }"#, "", ATTRIBUTES)
+            .replace(r#""extensions": { "KHR_materials_specular":"#, &format!("{emissive} \"KHR_materials_specular\":"));
+        std::fs::write(dir.path().join("sq.gltf"), json).unwrap();
+        let file = SceneFile::from_toml_str(&text, Some(dir.path())).unwrap_or_else(|e| panic!("{e}"));
+        let radiances: Vec<Vec3> = file
+            .scene
+            .lights()
+            .iter()
+            .filter_map(|l| match l {
+                airlight::light::Light::Triangle { radiance, .. } => Some(*radiance),
+                _ => None,
+            })
+            .collect();
+        assert_eq!(radiances.len(), lights, "grey {code}");
+        let want = Vec3::new(1.0, 0.5, 0.25) * 4.0 * srgb(code);
+        assert!(radiances.iter().all(|r| (*r - want).abs().max_element() < 1e-5), "{radiances:?} against {want}");
+        // The dark square is a surface again.
+        assert_eq!(file.scene.objects().len(), if lights == 0 { 1 } else { 0 }, "grey {code}");
+    }
+}

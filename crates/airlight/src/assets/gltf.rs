@@ -223,9 +223,33 @@ impl Loader<'_> {
             if !(emission.is_finite() && emission.min_element() >= 0.0) {
                 return Err(format!("{at}: its material's emission is not finite and ≥ 0: {emission}"));
             }
+            let mut triangles = triangles;
             if emission.max_element() > 0.0 && include.material.is_none() {
-                out.parts.lights.extend(Light::triangles_of(&positions, &triangles, emission));
-                continue;
+                let Some(info) = material.emissive_texture() else {
+                    out.parts.lights.extend(Light::triangles_of(&positions, &triangles, emission));
+                    continue;
+                };
+                // Each triangle glows with the texture's mean over it; the
+                // dark ones stay surfaces of the material.
+                let at_material = material.index().map_or("the default material".into(), |i| format!("materials[{i}]"));
+                let map = self
+                    .gltf_map(textures, &info, "emissiveTexture", false)
+                    .map_err(|why| format!("{at_material}.{why}"))?;
+                let uvs = texture_coordinates(&primitive, info_set(&info), positions.len(), buffers)
+                    .map_err(|why| format!("{at}: {why}"))?;
+                let mut dark = Vec::new();
+                for t in triangles {
+                    let radiance = emission * map.mean_over_triangle(t.map(|i| uvs[i as usize]));
+                    if radiance.max_element() > 0.0 {
+                        out.parts.lights.extend(Light::triangles_of(&positions, &[t], radiance));
+                    } else {
+                        dark.push(t);
+                    }
+                }
+                triangles = dark;
+                if triangles.is_empty() {
+                    continue;
+                }
             }
             let mut uvs = Vec::new();
             let name = match include.material {
@@ -258,8 +282,7 @@ impl Loader<'_> {
 /// [`not_read`] says so when a material's maps ask for two.
 fn uv_set(material: &gltf::Material) -> Option<u32> {
     let pbr = material.pbr_metallic_roughness();
-    let set =
-        |info: gltf::texture::Info| info.texture_transform().and_then(|t| t.tex_coord()).unwrap_or(info.tex_coord());
+    let set = |info: gltf::texture::Info| info_set(&info);
     pbr.base_color_texture().map(set).or_else(|| pbr.metallic_roughness_texture().map(set))
 }
 
@@ -292,29 +315,8 @@ impl Loader<'_> {
         let metallic = unit(pbr.metallic_factor(), "metallicFactor")?;
         let roughness = unit(pbr.roughness_factor(), "roughnessFactor")?;
         let specular = unit(material.specular().map_or(1.0, |s| s.specular_factor()), "specularFactor")?;
-        let mut map = |info: Option<gltf::texture::Info>,
-                       what: &str,
-                       data: bool|
-         -> Result<Option<TextureMap>, String> {
-            let Some(info) = info else { return Ok(None) };
-            let texture =
-                self.gltf_texture(textures, &info.texture(), data).map_err(|why| format!("{at}.{what}: {why}"))?;
-            let transform = match info.texture_transform() {
-                Some(t) => {
-                    let transform = UvTransform {
-                        offset: Vec2::from_array(t.offset()),
-                        rotation: t.rotation(),
-                        scale: Vec2::from_array(t.scale()),
-                    };
-                    if !(transform.offset.is_finite() && transform.rotation.is_finite() && transform.scale.is_finite())
-                    {
-                        return Err(format!("{at}.{what}: its KHR_texture_transform is not finite"));
-                    }
-                    transform
-                }
-                None => UvTransform::IDENTITY,
-            };
-            Ok(Some(TextureMap { texture, transform }))
+        let mut map = |info: Option<gltf::texture::Info>, what: &str, data: bool| {
+            info.map(|info| self.gltf_map(textures, &info, what, data).map_err(|why| format!("{at}.{why}"))).transpose()
         };
         let maps = SurfaceMaps {
             base_colour: map(pbr.base_color_texture(), "pbrMetallicRoughness.baseColorTexture", false)?,
@@ -343,6 +345,40 @@ impl Loader<'_> {
             specular,
             maps: has_maps.then(|| Arc::new(maps)),
         }))
+    }
+}
+
+/// The coordinate set a texture reads (a `KHR_texture_transform` may name another).
+fn info_set(info: &gltf::texture::Info) -> u32 {
+    info.texture_transform().and_then(|t| t.tex_coord()).unwrap_or(info.tex_coord())
+}
+
+impl Loader<'_> {
+    /// A material's texture (`what`, its key) with its
+    /// `KHR_texture_transform`; errors begin with `what`.
+    fn gltf_map(
+        &self,
+        textures: &mut Textures,
+        info: &gltf::texture::Info,
+        what: &str,
+        data: bool,
+    ) -> Result<TextureMap, String> {
+        let texture = self.gltf_texture(textures, &info.texture(), data).map_err(|why| format!("{what}: {why}"))?;
+        let transform = match info.texture_transform() {
+            Some(t) => {
+                let transform = UvTransform {
+                    offset: Vec2::from_array(t.offset()),
+                    rotation: t.rotation(),
+                    scale: Vec2::from_array(t.scale()),
+                };
+                if !(transform.offset.is_finite() && transform.rotation.is_finite() && transform.scale.is_finite()) {
+                    return Err(format!("{what}: its KHR_texture_transform is not finite"));
+                }
+                transform
+            }
+            None => UvTransform::IDENTITY,
+        };
+        Ok(TextureMap { texture, transform })
     }
 }
 
@@ -427,8 +463,6 @@ fn not_read(doc: &serde_json::Value) -> Vec<String> {
     let cut_out = |m: &Value| m.get("alphaMode").and_then(Value::as_str).is_some_and(|a| a != "OPAQUE");
     note(count(&cut_out), "alphaMode MASK or BLEND", "cut-outs and glass are opaque");
     note(count(&|m| m.get("normalTexture").is_some()), "normal maps", "surfaces are shaded by their triangles");
-    let glowing_texture = |m: &Value| m.get("emissiveTexture").is_some();
-    note(count(&glowing_texture), "emissive textures", "such surfaces emit their emissiveFactor evenly");
     // KHR_materials_specular's factor is read; its colour and textures not.
     let specular = |m: &Value| {
         m.get("extensions").and_then(|e| e.get("KHR_materials_specular")).is_some_and(|s| {
@@ -788,7 +822,6 @@ mod tests {
             [
                 "alphaMode MASK or BLEND (1 material) not read: cut-outs and glass are opaque",
                 "normal maps (1 material) not read: surfaces are shaded by their triangles",
-                "emissive textures (1 material) not read: such surfaces emit their emissiveFactor evenly",
                 "KHR_materials_specular colours and textures (1 material) not read: only its specularFactor weighs the lobe",
                 "a second texture coordinate set (1 material) not read: the metallic-roughness map reads the base colour's",
                 "vertex normals not read: surfaces are shaded flat, triangle by triangle",

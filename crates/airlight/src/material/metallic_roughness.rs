@@ -73,7 +73,40 @@ impl TextureMap {
         let uv = self.transform.apply(uv);
         self.texture.sample(uv.x, uv.y)
     }
+
+    /// The texture's mean over the triangle with corners at coordinates
+    /// `uv`: the triangle cut into m² triangles of equal area (m from the
+    /// texels it covers, at most [`MAX_TRIANGLE_SPLIT`]), the texture
+    /// taken at each one's centroid.
+    pub fn mean_over_triangle(&self, uv: [Vec2; 3]) -> Rgb {
+        let (w, h) = self.texture.size();
+        let [a, b, c] = uv.map(|t| self.transform.apply(t) * Vec2::new(w as f32, h as f32));
+        let texels = 0.5 * (b - a).perp_dot(c - a).abs();
+        let m = if texels.is_finite() {
+            (2.0 * texels).sqrt().ceil().clamp(1.0, MAX_TRIANGLE_SPLIT as f32) as u32
+        } else {
+            1
+        };
+        let at = |s: f32, t: f32| self.sample(uv[0] + (uv[1] - uv[0]) * s + (uv[2] - uv[0]) * t);
+        let mut sum = glam::DVec3::ZERO;
+        let step = 1.0 / m as f32;
+        for i in 0..m {
+            for j in 0..m - i {
+                // The upright piece with corner (i, j), and the inverted one
+                // beside it where there is room.
+                sum += at((i as f32 + 1.0 / 3.0) * step, (j as f32 + 1.0 / 3.0) * step).as_dvec3();
+                if i + j + 1 < m {
+                    sum += at((i as f32 + 2.0 / 3.0) * step, (j as f32 + 2.0 / 3.0) * step).as_dvec3();
+                }
+            }
+        }
+        (sum / (m * m) as f64).as_vec3()
+    }
 }
+
+/// The finest cut of a triangle for [`TextureMap::mean_over_triangle`]:
+/// 64² pieces, enough for a triangle of two thousand texels a side.
+pub const MAX_TRIANGLE_SPLIT: u32 = 64;
 
 /// An affine map of texture coordinates: scale, then rotate, then offset,
 /// as `KHR_texture_transform` composes them. A rotation by r turns (u, v)
@@ -400,6 +433,30 @@ mod tests {
                 assert!((f - base / PI).abs().max_element() < 1e-7 && (pdf - wi.z.abs() / PI).abs() < 1e-6);
             }
         }
+    }
+
+    #[test]
+    fn a_triangles_mean_weighs_the_texels_it_covers() {
+        // A 256×1 texture, its left half white and its right half black:
+        // a triangle within the left half is white; the image's lower left
+        // half (corners (0, 0), (0, 1), (1, 1)), {0 ≤ u ≤ v ≤ 1}, has the
+        // mean 2∫₀^½ (1 − u) du = 3/4 (the bilinear ramp at the seam is
+        // symmetric about u = ½, so it weighs as the step).
+        let texels = (0..256).map(|i| if i < 128 { [255; 3] } else { [0; 3] }).collect();
+        let clamp = crate::texture::Wrap::ClampToEdge;
+        let map = TextureMap::new(Arc::new(Texture::from_srgb8(256, 1, texels).unwrap().with_wrap(clamp, clamp)));
+        let left = map.mean_over_triangle([Vec2::new(0.0, 0.0), Vec2::new(0.25, 0.0), Vec2::new(0.0, 1.0)]);
+        assert!((left.x - 1.0).abs() < 1e-6, "{left}");
+        let lower = map.mean_over_triangle([Vec2::new(0.0, 0.0), Vec2::new(0.0, 1.0), Vec2::new(1.0, 1.0)]);
+        assert!((lower.x - 0.75).abs() < 0.01, "{lower}");
+        // Moved by a transform: the same triangle read mirrored along u
+        // sees the black half where the white was.
+        let mirrored = TextureMap {
+            transform: UvTransform { offset: Vec2::X, rotation: 0.0, scale: Vec2::new(-1.0, 1.0) },
+            ..map.clone()
+        };
+        let lower = mirrored.mean_over_triangle([Vec2::new(0.0, 0.0), Vec2::new(0.0, 1.0), Vec2::new(1.0, 1.0)]);
+        assert!((lower.x - 0.25).abs() < 0.01, "{lower}");
     }
 
     #[test]

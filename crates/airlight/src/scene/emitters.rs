@@ -1,17 +1,18 @@
 //! Emitting meshes sampled as one light each. An emitting mesh is one
 //! triangle light per triangle (`Light::triangles_of`), and a loop that
 //! samples every light at every shading point would trace one shadow ray
-//! per triangle. So a run of consecutive triangle lights of the same
-//! radiance (the triangles of one mesh, in the order they were added) is
-//! one *emitter*: a shading point draws one of its triangles, with a chance
-//! in proportion to the triangle's area, and then a point on it uniformly
-//! by area. Together that is a point uniform by area over the whole run,
-//! whose solid-angle density is the triangle's own times the chance. Any
-//! grouping would be unbiased; this one keeps a mesh's triangles together,
-//! and two meshes that happen to follow each other with the same radiance
-//! are one emitter of their joint area, which is as right.
+//! per triangle. So a run of consecutive triangle lights (the triangles of
+//! one mesh, in the order they were added) is one *emitter*: a shading
+//! point draws one of its triangles, with a chance in proportion to the
+//! triangle's power (its area times the sum of its radiance's channels),
+//! and then a point on it uniformly by area. For a mesh of one radiance
+//! that is a point uniform by area over the whole run; a mesh whose
+//! triangles glow unevenly (an emissive texture) is sampled where it
+//! glows. The solid-angle density is the triangle's own times the chance.
+//! Any grouping would be unbiased; this one keeps a mesh's triangles
+//! together, and two meshes that happen to follow each other are one
+//! emitter, which is as right.
 
-use crate::Rgb;
 use crate::light::{Light, LightSample};
 use glam::{Vec2, Vec3};
 
@@ -39,14 +40,19 @@ impl Emitters {
         let mut start = 0;
         while start < n {
             let mut end = start + 1;
-            if let Some(radiance) = triangle_radiance(&lights[start]) {
-                while end < n && triangle_radiance(&lights[end]) == Some(radiance) {
+            if is_triangle(&lights[start]) {
+                while end < n && is_triangle(&lights[end]) {
                     end += 1;
                 }
             }
             emitters.firsts.push(start as u32);
-            let areas: Vec<f64> = lights[start..end].iter().map(area).collect();
-            let total: f64 = areas.iter().sum();
+            let mut areas: Vec<f64> = lights[start..end].iter().map(power).collect();
+            let mut total: f64 = areas.iter().sum();
+            if !(total > 0.0 && total.is_finite()) {
+                // Black triangles (or a sum past f64): evenly.
+                areas.iter_mut().for_each(|a| *a = 1.0);
+                total = areas.len() as f64;
+            }
             let mut sum = 0.0;
             for (k, a) in areas.iter().enumerate() {
                 let i = start + k;
@@ -120,18 +126,19 @@ impl Emitters {
 /// The largest f32 below 1.
 const ONE_BELOW: f32 = 1.0 - f32::EPSILON / 2.0;
 
-/// A triangle light's radiance; None for other lights.
-fn triangle_radiance(light: &Light) -> Option<Rgb> {
-    match *light {
-        Light::Triangle { radiance, .. } => Some(radiance),
-        _ => None,
-    }
+fn is_triangle(light: &Light) -> bool {
+    matches!(light, Light::Triangle { .. })
 }
 
-/// A triangle light's area (a light alone gets 1: its chance is 1 anyway).
-fn area(light: &Light) -> f64 {
+/// What a triangle light's chance is in proportion to: its area times the
+/// sum of its radiance's channels (a light alone gets 1: its chance is 1
+/// anyway).
+fn power(light: &Light) -> f64 {
     match *light {
-        Light::Triangle { edge_1, edge_2, .. } => 0.5 * edge_1.as_dvec3().cross(edge_2.as_dvec3()).length(),
+        Light::Triangle { edge_1, edge_2, radiance, .. } => {
+            let area = 0.5 * edge_1.as_dvec3().cross(edge_2.as_dvec3()).length();
+            area * radiance.as_dvec3().element_sum()
+        }
         _ => 1.0,
     }
 }
@@ -139,6 +146,7 @@ fn area(light: &Light) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::Rgb;
     use glam::vec3;
 
     /// A unit square at height 1 facing down, cut into triangles of unequal
@@ -158,20 +166,24 @@ mod tests {
     }
 
     #[test]
-    fn runs_of_equal_triangles_are_one_emitter_and_others_stand_alone() {
+    fn runs_of_triangles_are_one_emitter_drawn_by_power_and_others_stand_alone() {
         let red = Rgb::new(4.0, 1.0, 1.0);
         let mut lights = vec![Light::point(Vec3::ONE, Rgb::ONE)];
         lights.extend(fan(red));
-        lights.extend(fan(Rgb::splat(2.0)));
+        lights.extend(fan(Rgb::splat(4.0)));
         lights.push(Light::quad(Vec3::ZERO, Vec3::X, Vec3::Z, red));
         let emitters = Emitters::new(&lights);
-        assert_eq!(emitters.firsts(), &[0, 1, 6, 11]);
-        for (i, first) in [(0, 0), (1, 1), (3, 1), (5, 1), (6, 6), (10, 6), (11, 11)] {
+        assert_eq!(emitters.firsts(), &[0, 1, 11]);
+        for (i, first) in [(0, 0), (1, 1), (3, 1), (5, 1), (6, 1), (10, 1), (11, 11)] {
             assert_eq!(emitters.first_of[i], first, "light {i}");
         }
-        // The chances are the areas' shares of the square: 0.1, 0.25, 0.15, 0.2, 0.3.
-        let chances: Vec<f32> = (1..6).map(|i| emitters.chance(i)).collect();
-        for (got, want) in chances.iter().zip([0.1, 0.25, 0.15, 0.2, 0.3]) {
+        // The areas' shares of each square are 0.1, 0.25, 0.15, 0.2, 0.3;
+        // the white square has twice the red one's power (channels summing
+        // to 12 against 6), so a third of the draws go to the red one.
+        let chances: Vec<f32> = (1..11).map(|i| emitters.chance(i)).collect();
+        let shares = [0.1, 0.25, 0.15, 0.2, 0.3];
+        let want = shares.iter().map(|s| s / 3.0).chain(shares.iter().map(|s| s * 2.0 / 3.0));
+        for (got, want) in chances.iter().zip(want) {
             assert!((got - want).abs() < 1e-6, "{chances:?}");
         }
         assert_eq!(emitters.chance(0), 1.0);
