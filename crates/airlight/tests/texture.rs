@@ -260,8 +260,10 @@ fn a_gltf_emissive_texture_sets_each_triangles_radiance() {
                   "extensions": { "KHR_materials_emissive_strength": { "emissiveStrength": 4 },"#;
     for (code, lights) in [(128u8, 2), (0, 0)] {
         std::fs::write(dir.path().join("one.png"), png(&[[code; 3]], 1, 1)).unwrap();
-        let json = gltf(r#"{ "uri": "one.png" }"#, "", ATTRIBUTES)
-            .replace(r#""extensions": { "KHR_materials_specular":"#, &format!("{emissive} \"KHR_materials_specular\":"));
+        let json = gltf(r#"{ "uri": "one.png" }"#, "", ATTRIBUTES).replace(
+            r#""extensions": { "KHR_materials_specular":"#,
+            &format!("{emissive} \"KHR_materials_specular\":"),
+        );
         std::fs::write(dir.path().join("sq.gltf"), json).unwrap();
         let file = SceneFile::from_toml_str(&text, Some(dir.path())).unwrap_or_else(|e| panic!("{e}"));
         let radiances: Vec<Vec3> = file

@@ -60,6 +60,10 @@ pub struct RenderArgs {
     /// `type="height",sigma_s=0.2,falloff=0.5`; `none` for no medium.
     #[arg(long, value_name = "KEY=VALUE,...", value_parser = parse_medium)]
     pub(super) medium: Option<MediumOption>,
+    /// A uniform sky instead of the scene's: its radiance, a number or
+    /// `[r,g,b]` (≥ 0); `none` for no sky.
+    #[arg(long, value_name = "RADIANCE", value_parser = parse_sky)]
+    pub(super) sky: Option<airlight::Rgb>,
     /// Worker threads (default: all cores). The image does not depend on it.
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=crate::preflight::MAX_THREADS as i64))]
     pub(super) threads: Option<u32>,
@@ -88,7 +92,26 @@ pub(super) fn configure(args: &RenderArgs) -> Result<SceneFile, String> {
     if let Some(MediumOption(medium)) = &args.medium {
         file.scene.set_medium(medium.clone()).map_err(|e| format!("--medium: {e}"))?;
     }
+    if let Some(radiance) = args.sky {
+        file.scene.set_sky(radiance);
+    }
     Ok(file)
+}
+
+/// `--sky`: a radiance, a number or `[r,g,b]`, finite and ≥ 0; `none` is 0.
+fn parse_sky(s: &str) -> Result<airlight::Rgb, String> {
+    use airlight::options::OptionValue;
+    let rgb = match OptionValue::parse_word(s) {
+        OptionValue::Text(t) if t == "none" => return Ok(airlight::Rgb::ZERO),
+        OptionValue::Int(n) => [n as f64; 3],
+        OptionValue::Float(x) => [x; 3],
+        OptionValue::List(v) if v.len() == 3 => [v[0], v[1], v[2]],
+        _ => return Err(format!("`{s}` is not a radiance: a number, [r,g,b] or none")),
+    };
+    if rgb.iter().any(|c| !(c.is_finite() && *c >= 0.0 && *c <= f32::MAX as f64)) {
+        return Err(format!("`{s}`: a radiance is finite and ≥ 0"));
+    }
+    Ok(airlight::Rgb::new(rgb[0] as f32, rgb[1] as f32, rgb[2] as f32))
 }
 
 /// `--medium`: a medium, or None for `none`.

@@ -83,7 +83,7 @@ impl Light {
             Light::Line { start, end, .. } => Some(0.5 * (start + end)),
             Light::Volume { shape: LightVolume::Box { min, max }, .. } => Some(0.5 * (min + max)),
             Light::Volume { shape: LightVolume::Sphere { center, .. }, .. } => Some(center),
-            Light::Distant { .. } => None,
+            Light::Distant { .. } | Light::Sky { .. } => None,
         }
     }
 
@@ -104,7 +104,7 @@ impl Light {
                 (*min, *max) = (p - half, p + half);
             }
             Light::Volume { shape: LightVolume::Sphere { center, .. }, .. } => *center = p,
-            Light::Distant { .. } => {}
+            Light::Distant { .. } | Light::Sky { .. } => {}
         }
         self
     }

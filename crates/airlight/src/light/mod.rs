@@ -82,6 +82,13 @@ pub enum Light {
         shape: LightVolume,
         intensity: Rgb,
     },
+    /// A uniform sky: `radiance` arriving from every direction from beyond
+    /// the scene, and seen by rays that leave it. Sampled uniformly over
+    /// the sphere of directions (pdf 1/4π); in a medium, attenuated over
+    /// the scene's bounding sphere as a sun is.
+    Sky {
+        radiance: Rgb,
+    },
 }
 
 /// Light arriving at a point from one sampled direction.
@@ -120,6 +127,11 @@ impl Light {
 
     pub fn distant(direction: Vec3, irradiance: Rgb) -> Self {
         Light::Distant { direction: direction.normalize(), irradiance }
+    }
+
+    /// A uniform sky of `radiance`.
+    pub fn sky(radiance: Rgb) -> Self {
+        Light::Sky { radiance }
     }
 
     pub fn sphere(center: Vec3, radius: f32, radiance: Rgb) -> Self {
@@ -236,7 +248,7 @@ impl Light {
                 Some((a + (edge_1 + edge_2) / 3.0, spread(radius)))
             }
             Light::Line { start, end, .. } => Some((0.5 * (start + end), spread(0.5 * (end - start).length()))),
-            Light::Distant { .. } => None,
+            Light::Distant { .. } | Light::Sky { .. } => None,
         }
     }
 
@@ -327,6 +339,10 @@ impl Light {
             }
             // Two numbers given: the third is a hash of them (volume.rs).
             Light::Volume { .. } => self.sample3(p, u.extend(third_dimension(u))),
+            Light::Sky { radiance } => {
+                let wi = crate::sampling::uniform_sphere(u);
+                Some(LightSample { wi, distance: f32::INFINITY, weight: radiance * SPHERE, pdf: 1.0 / SPHERE })
+            }
         }
     }
 
@@ -347,6 +363,7 @@ impl Light {
             }
             Light::Quad { edge_u, edge_v, .. } => area_pdf(edge_u.cross(edge_v), wi, t),
             Light::Triangle { edge_1, edge_2, .. } => area_pdf(0.5 * edge_1.cross(edge_2), wi, t),
+            Light::Sky { .. } => 1.0 / SPHERE,
             _ => 0.0,
         }
     }
@@ -367,15 +384,19 @@ impl Light {
     }
 
     /// Radiance leaving the light's surface toward `-dir` at a point whose
-    /// outward normal is `n` (area lights; zero for others).
+    /// outward normal is `n` (area lights; a sky's radiance anywhere; zero
+    /// for others).
     pub fn emitted(&self, n: Vec3, dir: Vec3) -> Rgb {
         match *self {
-            Light::Sphere { radiance, .. } => radiance,
+            Light::Sphere { radiance, .. } | Light::Sky { radiance } => radiance,
             Light::Quad { radiance, .. } | Light::Triangle { radiance, .. } if n.dot(dir) < 0.0 => radiance,
             _ => Rgb::ZERO,
         }
     }
 }
+
+/// The solid angle of the sphere of directions, 4π.
+const SPHERE: f32 = 4.0 * std::f32::consts::PI;
 
 /// Direction and distance from `p` to a point light at `position`, and the
 /// factor that turns its intensity into irradiance on a facing surface:

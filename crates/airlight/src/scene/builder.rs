@@ -119,9 +119,16 @@ impl SceneBuilder {
             };
             placed.push((shape, material));
         }
+        // The metallic-roughness table is computed once per process; done
+        // here it counts as setup, not as the first samples' time (which
+        // the command line's time estimate probes).
+        if materials.iter().any(|m| matches!(m, Material::MetallicRoughness(_))) {
+            crate::material::microfacet::SpecularAlbedo::get();
+        }
         let emitters = Emitters::new(&lights);
         let light_culling = LightCulling::new(&lights, emitters.firsts());
         let placed_delta = placed_delta(&lights);
+        let skies = super::skies(&lights);
         let mut scene = Scene {
             settings,
             camera,
@@ -136,6 +143,7 @@ impl SceneBuilder {
             light_culling,
             emitters,
             placed_delta,
+            skies,
             files: Vec::new(),
             notes: Vec::new(),
         };

@@ -75,7 +75,7 @@ pub fn light_extent(light: &Light) -> f32 {
             let (lo, hi) = shape.bounds();
             reach([lo, hi])
         }
-        Light::Distant { .. } => 0.0,
+        Light::Distant { .. } | Light::Sky { .. } => 0.0,
     }
 }
 

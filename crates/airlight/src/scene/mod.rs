@@ -62,6 +62,8 @@ pub struct Scene {
     /// The indices of the delta lights with a place (see
     /// [`Scene::placed_delta_lights`]).
     placed_delta: Vec<u32>,
+    /// The sky lights (see [`Scene::skies`]).
+    skies: Vec<u32>,
     /// The files the scene was read from (see [`Scene::files`]).
     pub(crate) files: Vec<std::path::PathBuf>,
     /// What the scene file asked for that Airlight does not do (yet).
@@ -201,6 +203,37 @@ impl Scene {
         &self.placed_delta
     }
 
+    /// The indices of the sky lights: what a ray that leaves the scene
+    /// sees, besides the background.
+    pub fn skies(&self) -> &[u32] {
+        &self.skies
+    }
+
+    /// What a ray that leaves the scene sees, unweighted: the background
+    /// and every sky. (The path tracer weighs the skies against their
+    /// samples instead.)
+    pub fn escaped_radiance(&self) -> crate::Rgb {
+        self.skies
+            .iter()
+            .fold(self.settings.background, |sum, &i| sum + self.lights[i as usize].emitted(Vec3::ZERO, Vec3::ZERO))
+    }
+
+    /// Makes the scene's sky `radiance` (zero: no sky): the first sky light
+    /// takes it and any others go dark, or a sky is added when there is
+    /// none. The other lights keep their places and their animation paths.
+    pub fn set_sky(&mut self, radiance: crate::Rgb) {
+        let mut lights = self.lights.clone();
+        let mut first = true;
+        for light in lights.iter_mut().filter(|l| matches!(l, Light::Sky { .. })) {
+            *light = Light::sky(if first { radiance } else { crate::Rgb::ZERO });
+            first = false;
+        }
+        if first && radiance != crate::Rgb::ZERO {
+            lights.push(Light::sky(radiance));
+        }
+        self.set_lights(&lights);
+    }
+
     /// Replaces the lights (moved, dimmed, others) and brings everything
     /// that depends on them in step: the area lights' surfaces in the BVH
     /// (so the camera sees a light where it now is and its old surface casts
@@ -215,6 +248,7 @@ impl Scene {
         self.emitters = Emitters::new(&self.lights);
         self.light_culling = LightCulling::new(&self.lights, self.emitters.firsts());
         self.placed_delta = placed_delta(&self.lights);
+        self.skies = skies(&self.lights);
         if surfaces_moved {
             self.geometry = build_geometry(self.surfaces());
         }
@@ -294,6 +328,11 @@ pub struct Surface {
     pub emitter: Option<u32>,
 }
 
+/// See [`Scene::skies`].
+fn skies(lights: &[Light]) -> Vec<u32> {
+    lights.iter().enumerate().filter(|(_, light)| matches!(light, Light::Sky { .. })).map(|(i, _)| i as u32).collect()
+}
+
 /// See [`Scene::placed_delta_lights`].
 fn placed_delta(lights: &[Light]) -> Vec<u32> {
     lights.iter().enumerate().filter(|(_, light)| light.is_placed_delta()).map(|(i, _)| i as u32).collect()
@@ -353,7 +392,7 @@ fn bounding_sphere(geometry: &Geometry, lights: &[Light], camera: &Camera) -> (V
                 grow(lo);
                 grow(hi);
             }
-            Light::Distant { .. } => {}
+            Light::Distant { .. } | Light::Sky { .. } => {}
         }
     }
     let center = 0.5 * (min + max);

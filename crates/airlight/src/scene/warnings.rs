@@ -44,6 +44,7 @@ fn emits(light: &Light) -> bool {
         | Light::Volume { intensity, .. } => intensity,
         Light::Sphere { radiance, .. } | Light::Quad { radiance, .. } | Light::Triangle { radiance, .. } => radiance,
         Light::Distant { irradiance, .. } => irradiance,
+        Light::Sky { radiance } => radiance,
     };
     power.max_element() > 0.0
 }

@@ -25,11 +25,63 @@ pub fn parse(text: &str) -> Result<SceneDesc, SceneError> {
 /// scene lists those it read ([`Scene::files`]). The `[render]` table's
 /// integrator options are not read here (see [`crate::SceneFile`]).
 pub fn build(desc: &SceneDesc, text: &str, assets: &AssetPath) -> Result<Scene, SceneError> {
-    let checker = Checker::new(text, assets)?;
+    build_as(desc, text, assets, false)
+}
+
+/// [`build`], and when `model_alone` (a glTF file opened as the scene)
+/// what a model needs to be seen: a sky when it brings no light, and a
+/// camera that frames it when it brings none, each said in a note.
+pub(super) fn build_as(
+    desc: &SceneDesc,
+    text: &str,
+    assets: &AssetPath,
+    model_alone: bool,
+) -> Result<Scene, SceneError> {
+    let mut checker = Checker::new(text, assets)?;
+    checker.model_alone = model_alone;
     let mut scene = checker.scene(desc)?;
     scene.files = checker.loader.into_files();
     scene.notes = checker.notes.into_inner();
     Ok(scene)
+}
+
+/// The sky that lights a model opened alone without lights of its own.
+const MODEL_SKY: f32 = 1.0;
+
+/// The vertical field of view of the camera that frames a model.
+const MODEL_FOV_DEGREES: f32 = 40.0;
+
+/// A camera that frames the meshes and lights of `included`: it looks at
+/// the centre of their bounds from the front (+z, glTF's front) and a
+/// little above, far enough that the sphere around their bounding box,
+/// seen as a disk, fits the narrower of the two fields of view. None when
+/// they hold no mesh.
+fn framing_camera(included: &[crate::assets::Imported], aspect: f32) -> Option<crate::camera::Camera> {
+    let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
+    for imported in included {
+        for (shape, _) in &imported.parts.objects {
+            if let crate::geometry::Shape::Mesh { positions, .. } = shape {
+                positions.iter().for_each(|p| (lo, hi) = (lo.min(*p), hi.max(*p)));
+            }
+        }
+        for light in &imported.parts.lights {
+            if let crate::light::Light::Triangle { a, edge_1, edge_2, .. } = *light {
+                for p in [a, a + edge_1, a + edge_2] {
+                    (lo, hi) = (lo.min(p), hi.max(p));
+                }
+            }
+        }
+    }
+    if !(lo.is_finite() && hi.is_finite()) {
+        return None;
+    }
+    let centre = 0.5 * (lo + hi);
+    let radius = (0.5 * (hi - lo).length()).max(1e-3);
+    let half = (0.5 * MODEL_FOV_DEGREES).to_radians();
+    let narrower = if aspect < 1.0 { (half.tan() * aspect).atan() } else { half };
+    let distance = radius / narrower.tan();
+    let from = Vec3::new(0.0, 0.25, 1.0).normalize() * distance;
+    Some(crate::camera::Camera::look_at(centre + from, centre, Vec3::Y, MODEL_FOV_DEGREES))
 }
 
 /// The checks and building of one scene file: its text, where each value
@@ -44,6 +96,8 @@ pub(super) struct Checker<'a> {
     pub(super) loader: Loader<'a>,
     /// What was asked for and is not done (see [`Scene::notes`]).
     pub(super) notes: RefCell<Vec<String>>,
+    /// Whether the scene is a glTF file opened alone ([`build_as`]).
+    model_alone: bool,
 }
 
 pub(super) type Result<T, E = SceneError> = std::result::Result<T, E>;
@@ -54,7 +108,13 @@ impl<'a> Checker<'a> {
             let at = e.span().map_or(0, |s| s.start);
             SceneError::at(text, at, e.message().trim_end())
         })?;
-        Ok(Checker { text, document: document.into_inner(), loader: Loader::new(assets), notes: RefCell::default() })
+        Ok(Checker {
+            text,
+            document: document.into_inner(),
+            loader: Loader::new(assets),
+            notes: RefCell::default(),
+            model_alone: false,
+        })
     }
 }
 
@@ -99,9 +159,28 @@ impl Checker<'_> {
         {
             settings.film.height = ((settings.film.width as f32 / aspect).round() as u32).clamp(1, MAX_IMAGE_SIDE);
         }
+        let aspect = settings.film.width as f32 / settings.film.height.max(1) as f32;
         let mut builder = SceneBuilder::new().settings(settings);
+        let framed = included_camera.is_none() && desc.camera.is_none() && self.model_alone;
         if let Some((camera, _)) = included_camera {
             builder = builder.camera(camera);
+        }
+        if framed && let Some(camera) = framing_camera(&included, aspect) {
+            self.notes.borrow_mut().push(format!(
+                "the model has no camera: added one at {} looking at the centre of its bounds",
+                camera.position
+            ));
+            builder = builder.camera(camera);
+        }
+        // Glowing surfaces (emissive materials) rarely light a model: a
+        // model without lights of its own (KHR_lights_punctual) gets a sky.
+        let glow = |l: &crate::light::Light| matches!(l, crate::light::Light::Triangle { .. });
+        if self.model_alone && desc.lights.is_empty() && included.iter().all(|i| i.parts.lights.iter().all(glow)) {
+            self.notes.borrow_mut().push(format!(
+                "the model has no lights: added a uniform sky of radiance {MODEL_SKY} (a scene file that \
+                 includes the model sets its own lights)"
+            ));
+            builder = builder.light(crate::light::Light::sky(crate::Rgb::splat(MODEL_SKY)));
         }
         if desc.camera.is_some() {
             builder = builder.camera(self.camera()?);

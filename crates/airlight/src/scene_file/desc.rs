@@ -428,6 +428,8 @@ tagged! {
         Point(PointLight) = "point",
         Spot(SpotLight) = "spot",
         Distant(DistantLight) = "distant",
+        /// A uniform sky.
+        Sky(SkyLight) = "sky",
         Sphere(SphereLight) = "sphere",
         Quad(QuadLight) = "quad",
         Line(LineLight) = "line",
@@ -510,6 +512,12 @@ falloff_keys! {
         volume: Option<bool>,
         intensity: Option<Triple>,
     }
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct SkyLight {
+    pub radiance: Triple,
 }
 
 #[derive(Debug, Deserialize)]

@@ -33,6 +33,7 @@ impl<'a> Checker<'a> {
                 (Light::point(point(l.position, "position")?, power(l.intensity, "intensity")?), l.falloff())
             }
             LightDesc::Spot(l) => (self.spot(span.clone(), label, l)?, l.falloff()),
+            LightDesc::Sky(l) => return Ok(Light::sky(power(l.radiance, "radiance")?)),
             LightDesc::Distant(l) => {
                 let d = self.direction(span.clone(), &at("direction"), l.direction.0)?;
                 return Ok(Light::distant(d, power(l.irradiance, "irradiance")?));
@@ -147,14 +148,14 @@ impl<'a> Checker<'a> {
     }
 
     /// A light's `keyframes`: times in [0, 1], strictly increasing, finite
-    /// positions; not on a distant light.
+    /// positions; not on a distant light or a sky.
     pub(super) fn keyframes(&self, index: usize, motion: &LightMotion, light: &Light) -> Result<Option<Keyframes>> {
         let Some(keys) = &motion.keyframes else {
             return Ok(None);
         };
         let label = format!("lights[{index}].keyframes");
         if light.position().is_none() {
-            return Err(self.err(keys.span(), format!("{label}: a distant light has no position to move")));
+            return Err(self.err(keys.span(), format!("{label}: a distant light or a sky has no position to move")));
         }
         if keys.get_ref().is_empty() {
             return Err(self.err(keys.span(), format!("{label} needs at least one {{ time, position }} key")));

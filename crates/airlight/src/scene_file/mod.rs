@@ -49,7 +49,12 @@ impl SceneFile {
         if let Some(gltf) = path.file_name().filter(|_| is_gltf(path)) {
             let text = format!("[[include]]\nfile = {}\n", toml::Value::from(gltf.to_string_lossy().into_owned()));
             // The error is the glTF file's, not of the text made here.
-            return Self::from_toml_with(&text, &assets).map_err(|e| SceneError { location: None, ..e }.in_file(path));
+            let model = || -> Result<SceneFile, SceneError> {
+                let desc = parse(&text)?;
+                let scene = check::build_as(&desc, &text, &assets, true)?;
+                Ok(SceneFile { scene, integrator: integrator_options(&desc.render, false, &text)? })
+            };
+            return model().map_err(|e| SceneError { location: None, ..e }.in_file(path));
         }
         let text = read_text(path, MAX_SCENE_BYTES, "scene file").map_err(|e| e.in_file(path))?;
         let mut file = Self::from_toml_with(&text, &assets).map_err(|e| e.in_file(path))?;

@@ -332,6 +332,12 @@ impl Analytic {
                         "the analytic integrator has no closed form for a volume light (lights[{i}]): use stochastic"
                     ));
                 }
+                Light::Sky { .. } => {
+                    return Err(format!(
+                        "the analytic integrator has no closed form for a sky light (lights[{i}]): use direct, \
+                         raymarch or path"
+                    ));
+                }
                 Light::Distant { .. } => {
                     if in_medium {
                         return Err(format!(

@@ -337,8 +337,19 @@ impl PathTracer {
                 }
             }
             let Some(hit) = hit else {
-                // Escaped: the background, which nothing samples directly.
+                // Escaped: the background, which nothing samples directly,
+                // and the skies, which next-event estimation samples too.
                 l += beta * scene.settings().background / avg(r_u);
+                for &index in scene.skies() {
+                    let light = &scene.lights()[index as usize];
+                    let le = light.emitted(Vec3::ZERO, ray.dir);
+                    if depth == 0 {
+                        l += beta * le / avg(r_u);
+                    } else {
+                        let r_l = r_l * light.pdf(prev_p, ray.dir, f32::INFINITY);
+                        l += beta * le * power_heuristic(r_u, r_l, hero);
+                    }
+                }
                 return l;
             };
             let surface = scene.geometry().surface(&ray, hit);
