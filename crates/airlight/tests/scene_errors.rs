@@ -153,7 +153,7 @@ fn cases() -> Vec<(String, usize, &'static str)> {
         (
             "[materials.m]\ntype = \"glass\"\n".into(),
             2,
-            "unknown type `glass`; materials are diffuse, checker, phong or texture",
+            "unknown type `glass`; materials are diffuse, checker, phong, texture or metallic_roughness",
         ),
         // 26. Checker field on a diffuse material.
         (

@@ -155,7 +155,8 @@ impl<'a> Checker<'a> {
         };
         let label = format!("lights[{index}].keyframes");
         if light.position().is_none() {
-            return Err(self.err(keys.span(), format!("{label}: a distant light or a sky has no position to move")));
+            let what = if matches!(light, Light::Sky { .. }) { "sky" } else { "distant light" };
+            return Err(self.err(keys.span(), format!("{label}: a {what} has no position to move")));
         }
         if keys.get_ref().is_empty() {
             return Err(self.err(keys.span(), format!("{label} needs at least one {{ time, position }} key")));
