@@ -57,7 +57,7 @@ fn displaced_sphere(n: u32) -> Shape {
             triangles.push([a + 1, b, b + 1]);
         }
     }
-    Shape::Mesh { positions, triangles, uvs: Vec::new() }
+    Shape::Mesh { positions, triangles, uvs: Vec::new(), normals: Vec::new() }
 }
 
 fn main() {

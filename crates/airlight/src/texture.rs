@@ -83,6 +83,10 @@ pub struct Texture {
     linear: bool,
     /// The mean linear colour, for surfaces without texture coordinates.
     mean: Rgb,
+    /// A hash of the texels, computed once: the debug text (a render's
+    /// fingerprint) names the texture by it, and a mesh's every emitting
+    /// triangle names its texture.
+    checksum: u64,
 }
 
 impl std::fmt::Debug for Texture {
@@ -95,15 +99,15 @@ impl std::fmt::Debug for Texture {
             .field("mean", &self.mean)
             // The texels themselves, so that the debug text (a render's
             // fingerprint) changes with any of them, not only with the mean.
-            .field("checksum", &format_args!("{:016x}", self.checksum()))
+            .field("checksum", &format_args!("{:016x}", self.checksum))
             .finish()
     }
 }
 
 impl Texture {
     /// A hash of the texels' bytes, three to a word.
-    fn checksum(&self) -> u64 {
-        crate::geometry::checksum(self.texels.iter().map(|&[r, g, b]| u32::from_le_bytes([r, g, b, 0])))
+    fn texel_checksum(texels: &[[u8; 3]]) -> u64 {
+        crate::geometry::checksum(texels.iter().map(|&[r, g, b]| u32::from_le_bytes([r, g, b, 0])))
     }
 
     /// A texture of `width × height` sRGB texels, row by row from the top;
@@ -112,6 +116,7 @@ impl Texture {
         if width == 0 || height == 0 || texels.len() as u64 != width as u64 * height as u64 {
             return None;
         }
+        let checksum = Texture::texel_checksum(&texels);
         let mut texture = Texture {
             width,
             height,
@@ -120,6 +125,7 @@ impl Texture {
             wrap_v: Wrap::Repeat,
             linear: false,
             mean: Rgb::ZERO,
+            checksum,
         };
         texture.mean = texture.texel_mean();
         Some(texture)

@@ -239,7 +239,7 @@ fn mesh_shadows_match_raymarch() {
             .collect();
         let faces = [[0, 1, 3, 2], [4, 6, 7, 5], [0, 4, 5, 1], [2, 3, 7, 6], [0, 2, 6, 4], [1, 5, 7, 3]];
         let triangles = faces.iter().flat_map(|f| [[f[0], f[1], f[2]], [f[0], f[2], f[3]]]).collect();
-        Shape::Mesh { positions, triangles, uvs: Vec::new() }
+        Shape::Mesh { positions, triangles, uvs: Vec::new(), normals: Vec::new() }
     };
     let rotated = glam::Affine3A::from_rotation_translation(
         glam::Quat::from_rotation_y(0.6) * glam::Quat::from_rotation_x(0.3),

@@ -202,7 +202,7 @@ fn bvh_agrees_with_brute_force_on_a_triangle_soup() {
         triangles.push([3 * i, 3 * i + 1, 3 * i + 2]);
     }
     let mut builder = GeometryBuilder::default();
-    builder.add(&Shape::Mesh { positions, triangles, uvs: Vec::new() }, 0, None);
+    builder.add(&Shape::Mesh { positions, triangles, uvs: Vec::new(), normals: Vec::new() }, 0, None);
     builder.add(&Shape::sphere(Vec3::new(1.0, 2.0, 0.0), 1.5), 0, None);
     builder.add(&Shape::plane(Vec3::new(0.0, -5.5, 0.0), Vec3::Y), 0, None);
     let geometry = builder.build();

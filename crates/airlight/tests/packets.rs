@@ -30,7 +30,7 @@ fn bumpy_sphere(n: u32) -> Shape {
             triangles.push([a + 1, b, b + 1]);
         }
     }
-    Shape::Mesh { positions, triangles, uvs: Vec::new() }
+    Shape::Mesh { positions, triangles, uvs: Vec::new(), normals: Vec::new() }
 }
 
 /// The mesh on a floor plane, with a sphere and a box beside it (leaves
@@ -193,7 +193,7 @@ fn a_hit_exactly_at_tmax_is_past_the_open_segment_in_packets_too() {
         }
     }
     let mut b = GeometryBuilder::default();
-    b.add(&Shape::Mesh { positions, triangles, uvs: Vec::new() }, 0, None);
+    b.add(&Shape::Mesh { positions, triangles, uvs: Vec::new(), normals: Vec::new() }, 0, None);
     let geometry = b.build();
     let rays: Vec<Ray> =
         (0..64).map(|i| Ray::new(Vec3::new(0.0625 * (i % 8) as f32, 0.0625 * (i / 8) as f32, 0.0), Vec3::Z)).collect();

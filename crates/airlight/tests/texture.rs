@@ -282,3 +282,17 @@ fn a_gltf_emissive_texture_sets_each_triangles_radiance() {
         assert_eq!(file.scene.objects().len(), if lights == 0 { 1 } else { 0 }, "grey {code}");
     }
 }
+
+/// The camera sees an emissive texture texel by texel, as a base colour
+/// texture under the sun: the same bilinear values, times the factor.
+#[test]
+fn a_gltf_emissive_texture_is_seen_point_by_point() {
+    let dir = folder();
+    let text = format!("{VIEW}\n[[include]]\nfile = \"sq.gltf\"\n");
+    let emissive = r#""emissiveFactor": [1, 0.5, 0.25], "emissiveTexture": { "index": 0 },
+                  "extensions": {"#;
+    let json = gltf(r#"{ "uri": "tex.png" }"#, r#", "sampler": 0"#, ATTRIBUTES)
+        .replace(r#""extensions": { "KHR_materials_specular":"#, &format!("{emissive} \"KHR_materials_specular\":"));
+    std::fs::write(dir.path().join("sq.gltf"), json).unwrap();
+    check("emissive", &render(&text, dir.path()), true, Vec3::new(1.0, 0.5, 0.25));
+}

@@ -15,7 +15,7 @@ use crate::camera::Camera;
 use crate::geometry::Shape;
 use crate::light::{Attenuation, Light, SpotProfile};
 use crate::material::{Material, MetallicRoughness, SurfaceMaps, TextureMap, UvTransform};
-use crate::scene::{Parts, limits};
+use crate::scene::{Parts, TexturedEmission, limits};
 use crate::texture::{Texture, Wrap};
 use base64::Engine;
 use glam::{Affine3A, Mat4, Vec2, Vec3};
@@ -86,9 +86,11 @@ impl Loader<'_> {
             }
         };
         // Memory: the triangles of every mesh each time a node places it,
-        // counted before any is read (a mesh may be placed many times).
+        // counted before any is read (a mesh may be placed many times),
+        // with their texture coordinates and vertex normals (72 bytes a
+        // triangle in the geometry, at most).
         let triangles = placed_triangles(&scene).map_err(&fail)?;
-        let bytes = triangles.saturating_mul(super::obj::BYTES_PER_TRIANGLE + 36);
+        let bytes = triangles.saturating_mul(super::obj::BYTES_PER_TRIANGLE + 72);
         self.reserve(bytes, || format!("the scene's meshes ({triangles} triangles placed by this glTF)"))
             .map_err(fail)?;
 
@@ -229,8 +231,10 @@ impl Loader<'_> {
                     out.parts.lights.extend(Light::triangles_of(&positions, &triangles, emission));
                     continue;
                 };
-                // Each triangle glows with the texture's mean over it; the
-                // dark ones stay surfaces of the material.
+                // Each triangle glows with the texture at each of its
+                // points; its light carries the texture's mean over it (its
+                // power, by which its mesh's triangles are drawn). The dark
+                // ones stay surfaces of the material.
                 let at_material = material.index().map_or("the default material".into(), |i| format!("materials[{i}]"));
                 let map = self
                     .gltf_map(textures, &info, "emissiveTexture", false)
@@ -239,9 +243,15 @@ impl Loader<'_> {
                     .map_err(|why| format!("{at}: {why}"))?;
                 let mut dark = Vec::new();
                 for t in triangles {
-                    let radiance = emission * map.mean_over_triangle(t.map(|i| uvs[i as usize]));
+                    let corners = t.map(|i| uvs[i as usize]);
+                    let radiance = emission * map.mean_over_triangle(corners);
                     if radiance.max_element() > 0.0 {
-                        out.parts.lights.extend(Light::triangles_of(&positions, &[t], radiance));
+                        let light = Light::triangles_of(&positions, &[t], radiance);
+                        if !light.is_empty() {
+                            let e = TexturedEmission { map: map.clone(), factor: emission, uvs: corners };
+                            out.parts.textured.push((out.parts.lights.len(), e));
+                            out.parts.lights.extend(light);
+                        }
                     } else {
                         dark.push(t);
                     }
@@ -270,7 +280,9 @@ impl Loader<'_> {
                     name
                 }
             };
-            out.parts.objects.push((Shape::Mesh { positions, triangles, uvs }, name));
+            let normals =
+                vertex_normals(&primitive, world, positions.len(), buffers).map_err(|why| format!("{at}: {why}"))?;
+            out.parts.objects.push((Shape::Mesh { positions, triangles, uvs, normals }, name));
         }
         Ok(())
     }
@@ -484,11 +496,6 @@ fn not_read(doc: &serde_json::Value) -> Vec<String> {
         a.zip(b).is_some_and(|(a, b)| a != b)
     };
     note(count(&two_sets), "a second texture coordinate set", "the metallic-roughness map reads the base colour's");
-    let meshes = doc.get("meshes").and_then(Value::as_array).unwrap_or(&empty);
-    let primitives = meshes.iter().filter_map(|m| m.get("primitives").and_then(Value::as_array)).flatten();
-    if primitives.clone().any(|p| p.get("attributes").and_then(|a| a.get("NORMAL")).is_some()) {
-        notes.push("vertex normals not read: surfaces are shaded flat, triangle by triangle".into());
-    }
     let used = doc.get("extensionsUsed").and_then(Value::as_array).unwrap_or(&empty);
     for name in used.iter().filter_map(Value::as_str) {
         if !READ_EXTENSIONS.contains(&name) {
@@ -606,6 +613,36 @@ fn percent_decoded(uri: &str) -> String {
         }
     }
     String::from_utf8_lossy(&out).into_owned()
+}
+
+/// A primitive's `NORMAL`s placed in the world (by the inverse transpose
+/// of the node's transform) and normalised; none when it has none. A
+/// normal of zero length stays zero (the triangle's own is used there).
+fn vertex_normals(
+    primitive: &gltf::Primitive,
+    world: Affine3A,
+    vertices: usize,
+    buffers: &[Vec<u8>],
+) -> Result<Vec<Vec3>, String> {
+    let Some(accessor) = primitive.get(&gltf::Semantic::Normals) else { return Ok(Vec::new()) };
+    use gltf::accessor::{DataType, Dimensions};
+    typed(&accessor, Dimensions::Vec3, &[DataType::F32])
+        .and_then(|()| fits(&accessor, buffers))
+        .map_err(|why| format!("NORMAL: {why}"))?;
+    let reader = primitive.reader(|b| buffers.get(b.index()).map(Vec::as_slice));
+    let to_world = world.matrix3.inverse().transpose();
+    let normals: Vec<Vec3> = reader
+        .read_normals()
+        .ok_or("NORMAL cannot be read")?
+        .map(|n| (to_world * Vec3::from_array(n)).normalize_or_zero())
+        .collect();
+    if normals.len() != vertices {
+        return Err(format!("NORMAL has {} elements for {vertices} vertices", normals.len()));
+    }
+    if let Some(n) = normals.iter().find(|n| !n.is_finite()) {
+        return Err(format!("NORMAL: a normal is not finite once placed: {n}"));
+    }
+    Ok(normals)
 }
 
 /// A primitive's `TEXCOORD_<set>`, one per vertex, finite.
@@ -824,7 +861,6 @@ mod tests {
                 "normal maps (1 material) not read: surfaces are shaded by their triangles",
                 "KHR_materials_specular colours and textures (1 material) not read: only its specularFactor weighs the lobe",
                 "a second texture coordinate set (1 material) not read: the metallic-roughness map reads the base colour's",
-                "vertex normals not read: surfaces are shaded flat, triangle by triangle",
                 "the extension KHR_materials_sheen not read",
             ]
         );

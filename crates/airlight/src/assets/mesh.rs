@@ -30,7 +30,12 @@ impl Loader<'_> {
     pub(crate) fn mesh(&self, name: &str) -> Result<Shape, String> {
         let obj = self.load_obj(name)?;
         if obj.triangle_texcoords.is_empty() {
-            return Ok(Shape::Mesh { positions: obj.positions, triangles: obj.triangles, uvs: Vec::new() });
+            return Ok(Shape::Mesh {
+                positions: obj.positions,
+                triangles: obj.triangles,
+                uvs: Vec::new(),
+                normals: Vec::new(),
+            });
         }
         Ok(compact(&obj, 0..obj.triangles.len(), true))
     }
@@ -102,7 +107,12 @@ impl Loader<'_> {
         {
             // One material: the mesh as read.
             let texture = texture_of(material)?;
-            let shape = Shape::Mesh { positions: obj.positions, triangles: obj.triangles, uvs: Vec::new() };
+            let shape = Shape::Mesh {
+                positions: obj.positions,
+                triangles: obj.triangles,
+                uvs: Vec::new(),
+                normals: Vec::new(),
+            };
             return Ok(vec![MeshPart { shape, material: material.take(), texture }]);
         }
         let mut parts = Vec::new();
@@ -151,5 +161,5 @@ fn compact(obj: &Obj, triangles: impl Iterator<Item = usize>, with_texcoords: bo
             })
         })
         .collect();
-    Shape::Mesh { positions, triangles, uvs }
+    Shape::Mesh { positions, triangles, uvs, normals: Vec::new() }
 }

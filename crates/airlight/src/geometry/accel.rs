@@ -12,7 +12,8 @@ use super::bvh::Bvh8;
 use super::collapse::{CollapseCosts, TreeShape, collapse};
 use super::lanes::LaneWidth;
 use super::records::{
-    Instance, NO_UV, PlaneRecord, Prim, Record, SdfPrim, UNBOUNDED_FAR, UnboundedSdf, barycentric, intersect_plane,
+    Instance, NO_ATTRIBUTES, PlaneRecord, Prim, Record, SdfPrim, TriangleAttributes, UNBOUNDED_FAR, UnboundedSdf,
+    barycentric, intersect_plane,
 };
 use super::sdf::sphere_trace;
 use super::shape::Shape;
@@ -85,7 +86,7 @@ pub struct Geometry {
     small: Option<Small>,
     bounds: Option<(Vec3, Vec3)>,
     /// The texture coordinates of the triangles that have them.
-    triangle_uvs: Vec<[Vec2; 3]>,
+    triangle_attributes: Vec<TriangleAttributes>,
 }
 
 /// Up to this many primitives are tested one by one, without the BVH: the
@@ -115,32 +116,36 @@ pub struct GeometryBuilder {
     records: Vec<Record>,
     planes: Vec<PlaneRecord>,
     unbounded: Vec<UnboundedSdf>,
-    triangle_uvs: Vec<[Vec2; 3]>,
+    triangle_attributes: Vec<TriangleAttributes>,
 }
 
 impl GeometryBuilder {
     /// Adds a shape with a material index and, for area lights, the index of
     /// the light it is the surface of.
     pub fn add(&mut self, shape: &Shape, material: u32, emitter: Option<u32>) {
-        let mut push = |prim| self.records.push(Record { prim, material, emitter, uv: NO_UV });
+        let mut push = |prim| self.records.push(Record { prim, material, emitter, attributes: NO_ATTRIBUTES });
         match shape {
             Shape::Sphere { center, radius } => push(Prim::Sphere { center: *center, radius: *radius }),
             Shape::Quad { corner, edge_u, edge_v } => {
                 push(Prim::Quad { corner: *corner, edge_u: *edge_u, edge_v: *edge_v })
             }
             Shape::Box { min, max } => push(Prim::Box { min: *min, max: *max }),
-            Shape::Mesh { positions, triangles, uvs } => {
+            Shape::Mesh { positions, triangles, uvs, normals } => {
                 let textured = !uvs.is_empty() && uvs.len() == positions.len();
+                let smooth = !normals.is_empty() && normals.len() == positions.len();
                 for tri in triangles {
                     let [a, b, c] = tri.map(|i| positions[i as usize]);
-                    let uv = if textured {
-                        self.triangle_uvs.push(tri.map(|i| uvs[i as usize]));
-                        self.triangle_uvs.len() as u32 - 1
+                    let attributes = if textured || smooth {
+                        self.triangle_attributes.push(TriangleAttributes {
+                            uvs: textured.then(|| tri.map(|i| uvs[i as usize])),
+                            normals: smooth.then(|| tri.map(|i| normals[i as usize])),
+                        });
+                        self.triangle_attributes.len() as u32 - 1
                     } else {
-                        NO_UV
+                        NO_ATTRIBUTES
                     };
                     let prim = Prim::Triangle { v0: a, e1: b - a, e2: c - a };
-                    self.records.push(Record { prim, material, emitter, uv });
+                    self.records.push(Record { prim, material, emitter, attributes });
                 }
             }
             Shape::Transformed { shape, world_from_local } => {
@@ -201,13 +206,13 @@ impl GeometryBuilder {
 
     /// Builds the BVH and lays the primitives out in its order.
     pub fn build(self) -> Geometry {
-        let GeometryBuilder { records, planes, unbounded, triangle_uvs } = self;
+        let GeometryBuilder { records, planes, unbounded, triangle_attributes } = self;
         let bounds = records.iter().map(|r| r.prim.bounds()).reduce(|a, b| a.union(&b));
         let bounds = bounds.map(|b| (Vec3::from(b.min), Vec3::from(b.max)));
         // Without a tree, every primitive is tested for every ray.
         if records.len() <= LINEAR_LIMIT {
             let small = small_scene(&records);
-            return Geometry { records, planes, unbounded, bounds, triangle_uvs, small, ..Geometry::default() };
+            return Geometry { records, planes, unbounded, bounds, triangle_attributes, small, ..Geometry::default() };
         }
         // A binary tree of one primitive a leaf, from which the collapse
         // chooses the leaves. obvhs's second reinsertion pass (run after
@@ -235,11 +240,11 @@ impl GeometryBuilder {
         // can make the tree deeper than the traversal's fixed stack: such
         // scenes are searched linearly instead, slow but right.
         if bvh.depth() > Bvh8::MAX_DEPTH {
-            return Geometry { records, planes, unbounded, bounds, triangle_uvs, ..Geometry::default() };
+            return Geometry { records, planes, unbounded, bounds, triangle_attributes, ..Geometry::default() };
         }
         let blocks = into_blocks(&mut bvh, &records);
         let small = small_scene(&records);
-        Geometry { records, planes, unbounded, blocks, bvh: Some(bvh), small, bounds, triangle_uvs }
+        Geometry { records, planes, unbounded, blocks, bvh: Some(bvh), small, bounds, triangle_attributes }
     }
 }
 
@@ -479,12 +484,25 @@ impl Geometry {
         self.records.get(surface.id as usize).and_then(|rec| self.uv_at(rec, surface.p))
     }
 
+    /// The shading normal at a surface point: a mesh's vertex normals
+    /// interpolated, normalised; None elsewhere (and where they cancel).
+    pub fn vertex_normal(&self, surface: &SurfaceHit) -> Option<Vec3> {
+        let rec = self.records.get(surface.id as usize)?;
+        let Prim::Triangle { v0, e1, e2 } = rec.prim else { return None };
+        if rec.attributes == NO_ATTRIBUTES {
+            return None;
+        }
+        let [n0, n1, n2] = self.triangle_attributes[rec.attributes as usize].normals?;
+        let [b1, b2] = barycentric(surface.p - v0, e1, e2);
+        (n0 * (1.0 - b1 - b2) + n1 * b1 + n2 * b2).try_normalize()
+    }
+
     /// The texture coordinates at point `p` of a record (see [`SurfaceHit::uv`]).
     fn uv_at(&self, rec: &Record, p: Vec3) -> Option<Vec2> {
         match rec.prim {
-            Prim::Triangle { v0, e1, e2 } if rec.uv != NO_UV => {
+            Prim::Triangle { v0, e1, e2 } if rec.attributes != NO_ATTRIBUTES => {
+                let [t0, t1, t2] = self.triangle_attributes[rec.attributes as usize].uvs?;
                 let [b1, b2] = barycentric(p - v0, e1, e2);
-                let [t0, t1, t2] = self.triangle_uvs[rec.uv as usize];
                 Some(t0 + (t1 - t0) * b1 + (t2 - t0) * b2)
             }
             Prim::Quad { corner, edge_u, edge_v } => {

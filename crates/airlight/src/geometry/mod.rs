@@ -22,6 +22,7 @@ pub use batch::Segment;
 pub use collapse::TreeShape;
 pub use lanes::LaneWidth;
 pub use ray::{Ray, offset_origin};
+pub(crate) use records::barycentric as barycentric_coordinates;
 pub use sdf::Sdf;
 pub(crate) use shape::checksum;
 pub use shape::{Shape, intersect_box, intersect_quad, intersect_sphere, intersect_triangle, triangle_blocks};

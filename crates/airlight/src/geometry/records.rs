@@ -3,7 +3,7 @@
 
 use super::sdf::{Sdf, sphere_trace};
 use super::shape::{box_normal, intersect_box, intersect_quad, intersect_sphere, intersect_triangle};
-use glam::{Affine3A, Mat3, Vec3, Vec3A};
+use glam::{Affine3A, Mat3, Vec2, Vec3, Vec3A};
 use obvhs::{Boundable, aabb::Aabb};
 
 /// One primitive the BVH holds.
@@ -63,14 +63,22 @@ pub(super) struct Record {
     pub prim: Prim,
     pub material: u32,
     pub emitter: Option<u32>,
-    /// A triangle's texture coordinates: its index in `Geometry::triangle_uvs`,
-    /// or [`NO_UV`]. (The field fits in the record's padding: meshes
-    /// without texture coordinates cost nothing more.)
-    pub uv: u32,
+    /// A triangle's texture coordinates and vertex normals: its index in
+    /// `Geometry::triangle_attributes`, or [`NO_ATTRIBUTES`]. (The field
+    /// fits in the record's padding: meshes without them cost nothing more.)
+    pub attributes: u32,
 }
 
-/// A record without texture coordinates of its own.
-pub(super) const NO_UV: u32 = u32::MAX;
+/// A record without texture coordinates or vertex normals of its own.
+pub(super) const NO_ATTRIBUTES: u32 = u32::MAX;
+
+/// What a mesh's triangle carries beyond its corners, each when its mesh
+/// has them: texture coordinates and vertex normals, at its three corners.
+#[derive(Clone, Debug)]
+pub(super) struct TriangleAttributes {
+    pub uvs: Option<[Vec2; 3]>,
+    pub normals: Option<[Vec3; 3]>,
+}
 
 /// An SDF that no box bounds (it holds a plane): traced on its own.
 #[derive(Clone, Debug)]
@@ -165,7 +173,7 @@ impl Boundable for Record {
 /// The coordinates (a, b) of `rel = a·e1 + b·e2` for a point in the plane
 /// of `e1` and `e2`, by least squares (the 2×2 normal equations).
 #[inline]
-pub(super) fn barycentric(rel: Vec3, e1: Vec3, e2: Vec3) -> [f32; 2] {
+pub(crate) fn barycentric(rel: Vec3, e1: Vec3, e2: Vec3) -> [f32; 2] {
     let (d11, d12, d22) = (e1.dot(e1), e1.dot(e2), e2.dot(e2));
     let (r1, r2) = (rel.dot(e1), rel.dot(e2));
     let det = d11 * d22 - d12 * d12;

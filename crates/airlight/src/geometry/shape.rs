@@ -30,13 +30,15 @@ pub enum Shape {
         min: Vec3,
         max: Vec3,
     },
-    /// A triangle mesh; `triangles` index `positions`, and `uvs` too when
-    /// the mesh has texture coordinates (one per position; empty when it
-    /// has none).
+    /// A triangle mesh; `triangles` index `positions`, and `uvs` and
+    /// `normals` too when the mesh has texture coordinates or vertex
+    /// normals (one per position; empty when it has none). Vertex normals
+    /// shade the surface smoothly (see [`crate::material::shading`]).
     Mesh {
         positions: Vec<Vec3>,
         triangles: Vec<[u32; 3]>,
         uvs: Vec<Vec2>,
+        normals: Vec<Vec3>,
     },
     /// A signed distance field, sphere traced (see `geometry::sdf`).
     Sdf(super::sdf::Sdf),
@@ -64,16 +66,19 @@ impl std::fmt::Debug for Shape {
                 f.debug_struct("Quad").field("corner", corner).field("edge_u", edge_u).field("edge_v", edge_v).finish()
             }
             Shape::Box { min, max } => f.debug_struct("Box").field("min", min).field("max", max).finish(),
-            Shape::Mesh { positions, triangles, uvs } => {
+            Shape::Mesh { positions, triangles, uvs, normals } => {
                 let words = positions.iter().flat_map(|p| p.to_array().map(f32::to_bits));
                 let words = words.chain(triangles.iter().flatten().copied());
                 let words = words.chain(uvs.iter().flat_map(|uv| uv.to_array().map(f32::to_bits)));
-                f.debug_struct("Mesh")
-                    .field("positions", &positions.len())
-                    .field("triangles", &triangles.len())
-                    .field("uvs", &uvs.len())
-                    .field("checksum", &format_args!("{:016x}", checksum(words)))
-                    .finish()
+                let words = words.chain(normals.iter().flat_map(|n| n.to_array().map(f32::to_bits)));
+                let mut d = f.debug_struct("Mesh");
+                d.field("positions", &positions.len()).field("triangles", &triangles.len()).field("uvs", &uvs.len());
+                // Listed only when there are some: a mesh without them keeps
+                // the text (a render's fingerprint) it had before they were read.
+                if !normals.is_empty() {
+                    d.field("normals", &normals.len());
+                }
+                d.field("checksum", &format_args!("{:016x}", checksum(words))).finish()
             }
             Shape::Sdf(sdf) => f.debug_tuple("Sdf").field(sdf).finish(),
             Shape::Transformed { shape, world_from_local } => {
@@ -129,8 +134,15 @@ impl Shape {
             Shape::Quad { corner, edge_u, edge_v } => {
                 Shape::Quad { corner: m.transform_point3(corner), edge_u: linear * edge_u, edge_v: linear * edge_v }
             }
-            Shape::Mesh { positions, triangles, uvs } => {
-                Shape::Mesh { positions: positions.iter().map(|&p| m.transform_point3(p)).collect(), triangles, uvs }
+            Shape::Mesh { positions, triangles, uvs, normals } => {
+                // Normals by the inverse transpose, as a plane's.
+                let normal_map = linear.inverse().transpose();
+                Shape::Mesh {
+                    positions: positions.iter().map(|&p| m.transform_point3(p)).collect(),
+                    triangles,
+                    uvs,
+                    normals: normals.iter().map(|&n| (normal_map * n).normalize_or_zero()).collect(),
+                }
             }
             Shape::Sphere { center, radius } if is_similarity(linear) => {
                 Shape::Sphere { center: m.transform_point3(center), radius: radius * linear.x_axis.length() }

@@ -99,9 +99,11 @@ fn light_terms_on(isa: Isa, scene: &Scene, points: &[LitPoint], scratch: &mut La
         return;
     }
     lambertian.clear();
-    lambertian.extend(
-        points.iter().zip(materials.iter()).map(|(point, m)| m.lambertian_brdf(point.surface.p, point.surface.n)),
-    );
+    lambertian.extend(points.iter().zip(materials.iter()).map(|(point, m)| {
+        // A smooth-shaded point's BRDF depends on the directions.
+        let flat = scene.shading_normal(&point.surface).is_none();
+        m.lambertian_brdf(point.surface.p, point.surface.n).filter(|_| flat)
+    }));
     in_lanes.clear();
     in_lanes.extend((0..points.len() as u32).filter(|&k| lambertian[k as usize].is_some()));
     for &first in scene.emitter_firsts() {

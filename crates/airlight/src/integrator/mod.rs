@@ -345,7 +345,7 @@ pub fn surface_radiance(
 /// What a surface emits toward `-ray.dir` (zero unless it is a light's).
 pub(crate) fn emitted(scene: &Scene, ray: &Ray, surface: &SurfaceHit) -> Rgb {
     match surface.emitter {
-        Some(light) => scene.lights()[light as usize].emitted(surface.n, ray.dir),
+        Some(light) => scene.emitted(light as usize, surface.p, surface.n, ray.dir),
         None => Rgb::ZERO,
     }
 }
@@ -391,7 +391,7 @@ pub(crate) fn light_term(
     if cos == 0.0 {
         return None;
     }
-    let f = material.brdf(surface.p, surface.n, wo, sample.wi);
+    let f = material.brdf_at(surface.p, surface.n, scene.shading_normal(surface), wo, sample.wi);
     if f == Rgb::ZERO {
         return None;
     }

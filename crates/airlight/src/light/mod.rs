@@ -378,6 +378,7 @@ impl Light {
                 positions: vec![a, a + edge_1, a + edge_2],
                 triangles: vec![[0, 1, 2]],
                 uvs: Vec::new(),
+                normals: Vec::new(),
             }),
             _ => None,
         }

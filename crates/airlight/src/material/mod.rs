@@ -2,6 +2,7 @@
 
 pub mod metallic_roughness;
 pub mod microfacet;
+pub mod shading;
 
 pub use metallic_roughness::{MetallicRoughness, SurfaceMaps, TextureMap, UvTransform};
 

@@ -2,6 +2,7 @@
 //! checks a scene file gets.
 
 use super::emitters::Emitters;
+use super::textured_emission::TexturedEmission;
 use super::{LightCulling, RenderSettings, Scene, SceneError, default_camera, geometry_of, limits, placed_delta};
 use crate::camera::Camera;
 use crate::geometry::{Geometry, Shape};
@@ -19,6 +20,9 @@ pub(crate) struct Parts {
     pub materials: Vec<(String, Material)>,
     pub objects: Vec<(Shape, String)>,
     pub lights: Vec<Light>,
+    /// The emission of the lights of `lights` (by index) whose radiance
+    /// varies over them.
+    pub textured: Vec<(usize, TexturedEmission)>,
 }
 
 /// Builds a [`Scene`] in Rust, as a World/Camera example in a tutorial would.
@@ -31,6 +35,7 @@ pub struct SceneBuilder {
     objects: Vec<(Shape, String)>,
     lights: Vec<Light>,
     light_paths: Vec<Option<Keyframes>>,
+    textured: Vec<(usize, TexturedEmission)>,
     medium: Option<Medium>,
 }
 
@@ -59,7 +64,9 @@ impl SceneBuilder {
     /// Adds the parts, materials first.
     pub(crate) fn parts(self, parts: Parts) -> Self {
         let builder = parts.materials.into_iter().fold(self, |b, (name, m)| b.material(&name, m));
-        let builder = parts.objects.into_iter().fold(builder, |b, (shape, name)| b.object(shape, &name));
+        let mut builder = parts.objects.into_iter().fold(builder, |b, (shape, name)| b.object(shape, &name));
+        let offset = builder.lights.len();
+        builder.textured.extend(parts.textured.into_iter().map(|(i, e)| (offset + i, e)));
         parts.lights.into_iter().fold(builder, SceneBuilder::light)
     }
 
@@ -109,7 +116,23 @@ impl SceneBuilder {
 
     /// Checks and builds the scene, with its BVH.
     pub fn build(self) -> Result<Scene, SceneError> {
-        let SceneBuilder { settings, camera, materials, material_names, objects, lights, light_paths, medium } = self;
+        let SceneBuilder {
+            settings,
+            camera,
+            materials,
+            material_names,
+            objects,
+            lights,
+            light_paths,
+            textured,
+            medium,
+        } = self;
+        let mut light_emission: Vec<Option<Box<TexturedEmission>>> = vec![None; lights.len()];
+        for (i, e) in textured {
+            if let Some(slot) = light_emission.get_mut(i) {
+                *slot = Some(Box::new(e));
+            }
+        }
         settings.validate().map_err(SceneError::new)?;
         let camera = camera.unwrap_or_else(default_camera);
         let mut placed = Vec::with_capacity(objects.len());
@@ -135,6 +158,7 @@ impl SceneBuilder {
             materials,
             lights,
             light_paths,
+            light_emission,
             medium: medium.filter(|m| !m.is_vacuum()),
             objects: placed,
             geometry: Geometry::default(),

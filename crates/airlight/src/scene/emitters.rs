@@ -111,15 +111,16 @@ impl Emitters {
     }
 
     /// A sample of the emitter that starts at light `first`, seen from `p`:
-    /// one of its lights drawn by [`Emitters::draw`], then a point of it,
-    /// with the density and weight of both choices together.
-    pub fn sample(&self, lights: &[Light], first: usize, p: Vec3, u: Vec2) -> Option<LightSample> {
+    /// one of its lights drawn by [`Emitters::draw`] (its index given),
+    /// then a point of it, with the density and weight of both choices
+    /// together.
+    pub fn sample(&self, lights: &[Light], first: usize, p: Vec3, u: Vec2) -> Option<(usize, LightSample)> {
         let (index, chance, u) = self.draw(first, u);
         let sample = lights[index].sample(p, u)?;
         if chance == 1.0 {
-            return Some(sample);
+            return Some((index, sample));
         }
-        Some(LightSample { pdf: sample.pdf * chance, weight: sample.weight / chance, ..sample })
+        Some((index, LightSample { pdf: sample.pdf * chance, weight: sample.weight / chance, ..sample }))
     }
 }
 
@@ -245,7 +246,7 @@ mod tests {
         for a in 0..side {
             for b in 0..side {
                 let u = Vec2::new((a as f32 + 0.5) / side as f32, (b as f32 + 0.5) / side as f32);
-                let s = emitters.sample(&lights, 0, p, u).expect("the square faces the point");
+                let (_, s) = emitters.sample(&lights, 0, p, u).expect("the square faces the point");
                 let quad_pdf = quad.pdf(p, s.wi, s.distance);
                 assert!((s.pdf / quad_pdf - 1.0).abs() < 1e-3, "{} against the quad's {quad_pdf}", s.pdf);
                 from_run += (s.weight.x * s.wi.y.abs()) as f64;

@@ -24,14 +24,43 @@ impl Scene {
     /// [`Scene::sample_emitter`].
     #[inline]
     pub fn sample_light(&self, index: usize, p: Vec3, u: Vec2) -> Option<LightSample> {
-        self.lights[index].sample(p, u).filter(|s| s.weight != Rgb::ZERO)
+        let sample = self.lights[index].sample(p, u)?;
+        Some(self.textured_sample(index, p, sample)).filter(|s| s.weight != Rgb::ZERO)
+    }
+
+    /// A sample of light `index` from `p` with its weight taken from the
+    /// light's emission at the sampled point, where that varies over the
+    /// light ([`crate::scene::TexturedEmission`]).
+    #[inline]
+    fn textured_sample(&self, index: usize, p: Vec3, sample: LightSample) -> LightSample {
+        match &self.light_emission[index] {
+            Some(e) if sample.pdf > 0.0 => {
+                let radiance = e.radiance_at(&self.lights[index], p + sample.wi * sample.distance);
+                LightSample { weight: radiance / sample.pdf, ..sample }
+            }
+            _ => sample,
+        }
+    }
+
+    /// The radiance leaving light `index`'s surface at `p` (outward normal
+    /// `n`) toward −`dir`: [`Light::emitted`], or its emission at `p` where
+    /// that varies over the light.
+    #[inline]
+    pub fn emitted(&self, index: usize, p: Vec3, n: Vec3, dir: Vec3) -> Rgb {
+        let light = &self.lights[index];
+        let le = light.emitted(n, dir);
+        match &self.light_emission[index] {
+            Some(e) if le != Rgb::ZERO => e.radiance_at(light, p),
+            _ => le,
+        }
     }
 
     /// [`Scene::sample_light`] with three uniform numbers, all of which a
     /// volume light uses (others the first two).
     #[inline]
     pub fn sample_light3(&self, index: usize, p: Vec3, u: Vec3) -> Option<LightSample> {
-        self.lights[index].sample3(p, u).filter(|s| s.weight != Rgb::ZERO)
+        let sample = self.lights[index].sample3(p, u)?;
+        Some(self.textured_sample(index, p, sample)).filter(|s| s.weight != Rgb::ZERO)
     }
 
     /// Whether nothing blocks `sample` (a light sample seen from `p`). On a
@@ -135,7 +164,8 @@ impl Scene {
     /// choices; for any other light, [`Scene::sample_light`].
     #[inline]
     pub fn sample_emitter(&self, first: usize, p: Vec3, u: Vec2) -> Option<LightSample> {
-        self.emitters.sample(&self.lights, first, p, u).filter(|s| s.weight != Rgb::ZERO)
+        let (index, sample) = self.emitters.sample(&self.lights, first, p, u)?;
+        Some(self.textured_sample(index, p, sample)).filter(|s| s.weight != Rgb::ZERO)
     }
 
     /// The chance with which [`Scene::sample_emitter`] draws light `index`

@@ -13,6 +13,7 @@ mod builder;
 mod emitters;
 mod error;
 mod light_queries;
+mod textured_emission;
 pub(crate) use light_queries::toward_sample;
 mod culling;
 pub mod limits;
@@ -32,6 +33,7 @@ use crate::material::Material;
 use crate::medium::Medium;
 use emitters::Emitters;
 use glam::Vec3;
+pub use textured_emission::TexturedEmission;
 
 /// The material index of an area light's own surface: it reflects nothing.
 const LIGHT_SURFACE: u32 = u32::MAX;
@@ -47,6 +49,9 @@ pub struct Scene {
     /// For each light, the path it moves along in animations (None: it
     /// stays put). See [`crate::light::Keyframes`].
     light_paths: Vec<Option<Keyframes>>,
+    /// Per light: its emission where it varies over the light (an
+    /// emissive texture; see [`Scene::emitted`]).
+    light_emission: Vec<Option<Box<TexturedEmission>>>,
     /// Never a vacuum: a medium that neither absorbs nor scatters is none.
     medium: Option<Medium>,
     /// The scene's objects (not the lights' surfaces), in world space, with
@@ -119,6 +124,13 @@ impl Scene {
     #[inline]
     pub fn material(&self, index: u32) -> &Material {
         self.materials.get(index as usize).unwrap_or(&Material::BLACK)
+    }
+
+    /// The normal a hit is shaded with when it is not its surface's own: a
+    /// mesh's vertex normals interpolated (see [`crate::material::shading`]).
+    #[inline]
+    pub fn shading_normal(&self, surface: &SurfaceHit) -> Option<Vec3> {
+        self.geometry.vertex_normal(surface)
     }
 
     /// The material at a hit, a texture looked up at its texture
@@ -245,6 +257,7 @@ impl Scene {
             || self.lights.iter().zip(lights).any(|(a, b)| a.surface() != b.surface());
         self.lights = lights.to_vec();
         self.light_paths.resize(self.lights.len(), None);
+        self.light_emission.resize(self.lights.len(), None);
         self.emitters = Emitters::new(&self.lights);
         self.light_culling = LightCulling::new(&self.lights, self.emitters.firsts());
         self.placed_delta = placed_delta(&self.lights);

@@ -109,7 +109,7 @@ fn the_fingerprint_follows_every_number_of_a_mesh() {
     let mesh = |positions: Vec<Vec3>, triangles: Vec<[u32; 3]>, uvs: Vec<Vec2>| {
         let scene = SceneBuilder::new()
             .material("grey", Material::diffuse(Rgb::splat(0.5)))
-            .object(Shape::Mesh { positions, triangles, uvs }, "grey")
+            .object(Shape::Mesh { positions, triangles, uvs, normals: Vec::new() }, "grey")
             .build()
             .unwrap();
         super::fingerprint(&scene, &IntegratorDesc::default())

@@ -274,7 +274,7 @@ impl Small {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::geometry::records::NO_UV;
+    use crate::geometry::records::NO_ATTRIBUTES;
     use crate::sampling::{Sampler, uniform_sphere};
     use glam::vec3;
 
@@ -292,7 +292,7 @@ mod tests {
             Prim::Box { min: vec3(0.2, 0.0, -0.6), max: vec3(0.8, 0.6, 0.0) },
             Prim::Sphere { center: vec3(0.4, 1.2, 0.5), radius: 0.3 },
         ];
-        prims.into_iter().map(|prim| Record { prim, material: 0, emitter: None, uv: NO_UV }).collect()
+        prims.into_iter().map(|prim| Record { prim, material: 0, emitter: None, attributes: NO_ATTRIBUTES }).collect()
     }
 
     #[test]
@@ -342,7 +342,12 @@ mod tests {
             normal_to_world: glam::Mat3::from(world_from_local.matrix3).inverse().transpose(),
             bounds: obvhs::aabb::Aabb::empty(),
         };
-        records.push(Record { prim: Prim::Instance(Box::new(instance)), material: 0, emitter: None, uv: NO_UV });
+        records.push(Record {
+            prim: Prim::Instance(Box::new(instance)),
+            material: 0,
+            emitter: None,
+            attributes: NO_ATTRIBUTES,
+        });
         let turned = records.len() - 1;
         let small = small_scene(&records).expect("a small scene");
         let mut s = Sampler::for_pixel(5, 2, 7);

@@ -122,7 +122,7 @@ mod tests {
             .collect();
         let faces = [[0, 1, 3, 2], [4, 6, 7, 5], [0, 4, 5, 1], [2, 3, 7, 6], [0, 2, 6, 4], [1, 5, 7, 3]];
         let triangles = faces.iter().flat_map(|f| [[f[0], f[1], f[2]], [f[0], f[2], f[3]]]).collect();
-        Shape::Mesh { positions, triangles, uvs: Vec::new() }
+        Shape::Mesh { positions, triangles, uvs: Vec::new(), normals: Vec::new() }
     }
 
     /// SplitMix64 in [0, 1).

@@ -132,7 +132,8 @@ pub(super) struct Bounce {
 enum Vertex<'a> {
     /// `material` as it is at the hit (a texture looked up);
     /// `light_numbers`, if stratified, the light samples' numbers.
-    Surface { p: Vec3, n: Vec3, wo: Vec3, material: &'a Material, light_numbers: Option<Vec2> },
+    /// `shading`: the normal the point is shaded with when not `n`.
+    Surface { p: Vec3, n: Vec3, shading: Option<Vec3>, wo: Vec3, material: &'a Material, light_numbers: Option<Vec2> },
     /// `on_gathered_segment`: on a segment whose delta lights' scattered
     /// light was gathered equiangularly (nee.rs).
     Medium { p: Vec3, wo: Vec3, on_gathered_segment: bool },
@@ -355,7 +356,7 @@ impl PathTracer {
             let surface = scene.geometry().surface(&ray, hit);
             if let Some(index) = surface.emitter {
                 let light = &scene.lights()[index as usize];
-                let le = light.emitted(surface.n, ray.dir);
+                let le = scene.emitted(index as usize, surface.p, surface.n, ray.dir);
                 if le != Rgb::ZERO {
                     if depth == 0 {
                         l += beta * le / avg(r_u);
@@ -381,28 +382,38 @@ impl PathTracer {
             depth += 1;
             let numbers = self.bounce(depth, sampler);
             let material = scene.material_at(&surface);
+            let shading = scene.shading_normal(&surface);
             if depth == 2
                 && let Some(split) = split.as_deref_mut()
                 && split.first.is_some()
                 && reuse::lambertian(&material)
+                && shading.is_none()
             {
                 split.second = Some(SecondVertex { p: surface.p, n: surface.n, own: l });
                 (roulette_scale, beta, l) = (beta, Rgb::ONE, Rgb::ZERO);
             }
             let wo = -ray.dir;
-            let vertex =
-                Vertex::Surface { p: surface.p, n: surface.n, wo, material: &material, light_numbers: numbers.light };
+            let vertex = Vertex::Surface {
+                p: surface.p,
+                n: surface.n,
+                shading,
+                wo,
+                material: &material,
+                light_numbers: numbers.light,
+            };
             let fog = Fog { medium, closed_form: self.closed_form };
             let guide = if self.guides(medium, depth) { Guide::at(scene, surface.p) } else { None };
             l += beta * direct_light(scene, fog, &vertex, r_u, hero, guide.as_ref(), sampler);
             let (wi, f, pdf) = match guided(guide.as_ref(), sampler) {
                 Some((guide, choice)) => {
                     let wi = guide.sample(choice, numbers.direction);
-                    let (f, pdf) = material.eval(surface.p, surface.n, wo, wi);
+                    let (f, pdf) = material.eval_at(surface.p, surface.n, shading, wo, wi);
                     (wi, f, pdf)
                 }
                 _ => {
-                    let Some(bs) = material.sample(surface.p, surface.n, wo, numbers.direction, sampler.next()) else {
+                    let sample =
+                        material.sample_at(surface.p, surface.n, shading, wo, numbers.direction, sampler.next());
+                    let Some(bs) = sample else {
                         return l;
                     };
                     (bs.wi, bs.f, bs.pdf)
@@ -422,7 +433,7 @@ impl PathTracer {
             if depth == 1
                 && let Some(split) = split.as_deref_mut()
             {
-                split.first = Some(FirstVertex { p: surface.p, n: surface.n, wo, material: material.clone() });
+                split.first = Some(FirstVertex { p: surface.p, n: surface.n, shading, wo, material: material.clone() });
             }
             if self.gathers(medium, depth) {
                 roulette_pending = true;

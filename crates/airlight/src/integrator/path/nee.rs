@@ -182,8 +182,8 @@ pub(super) fn direct_light(
         };
         let Some(ls) = scene.sample_emitter(index, p, u) else { return };
         let (f, scatter_pdf, normal) = match *vertex {
-            Vertex::Surface { p, n, material: m, .. } => {
-                let (brdf, pdf) = m.eval(p, n, wo, ls.wi);
+            Vertex::Surface { p, n, shading, material: m, .. } => {
+                let (brdf, pdf) = m.eval_at(p, n, shading, wo, ls.wi);
                 (brdf * ls.wi.dot(n).abs(), pdf, Some(n))
             }
             Vertex::Medium { .. } => {

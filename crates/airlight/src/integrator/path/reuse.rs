@@ -56,6 +56,8 @@ pub(crate) struct Split {
 pub(crate) struct FirstVertex {
     pub p: Vec3,
     pub n: Vec3,
+    /// The normal it is shaded with, when not `n`.
+    pub shading: Option<Vec3>,
     pub wo: Vec3,
     pub material: Material,
 }
@@ -101,7 +103,7 @@ pub(super) fn share(scene: &Scene, splits: &[Split], traced: &[Rgb], out: &mut [
             }
             let distance = distance2.sqrt();
             let dir = to / distance;
-            let (f, pdf) = first.material.eval(first.p, first.n, first.wo, dir);
+            let (f, pdf) = first.material.eval_at(first.p, first.n, first.shading, first.wo, dir);
             if pdf <= 0.0 {
                 continue;
             }
