@@ -83,6 +83,9 @@ pub struct Texture {
     linear: bool,
     /// The mean linear colour, for surfaces without texture coordinates.
     mean: Rgb,
+    /// Each texel's coverage (alpha over 255), row by row; empty for an
+    /// image without alpha or whose alpha is everywhere opaque.
+    alpha: Vec<u8>,
     /// A hash of the texels, computed once: the debug text (a render's
     /// fingerprint) names the texture by it, and a mesh's every emitting
     /// triangle names its texture.
@@ -125,10 +128,65 @@ impl Texture {
             wrap_v: Wrap::Repeat,
             linear: false,
             mean: Rgb::ZERO,
+            alpha: Vec::new(),
             checksum,
         };
         texture.mean = texture.texel_mean();
         Some(texture)
+    }
+
+    /// The same texture with a coverage for each texel (alpha over 255,
+    /// row by row); None if there is not one per texel. An alpha that is
+    /// opaque everywhere is not kept.
+    pub fn with_alpha(mut self, alpha: Vec<u8>) -> Option<Texture> {
+        if alpha.len() != self.texels.len() {
+            return None;
+        }
+        if alpha.iter().any(|&a| a != 255) {
+            self.checksum ^= crate::geometry::checksum(alpha.iter().map(|&a| a as u32)).rotate_left(1);
+            self.alpha = alpha;
+        }
+        Some(self)
+    }
+
+    /// Whether some texel is not fully opaque.
+    pub fn has_alpha(&self) -> bool {
+        !self.alpha.is_empty()
+    }
+
+    /// The bilinearly filtered coverage at (u, v), as [`Texture::sample`]
+    /// filters colour; 1 for an image without alpha.
+    pub fn alpha(&self, u: f32, v: f32) -> f32 {
+        if self.alpha.is_empty() {
+            return 1.0;
+        }
+        if !(u.is_finite() && v.is_finite()) {
+            return 1.0;
+        }
+        let (x0, y0, fx, fy) = self.footprint(u, v);
+        let at = |x: i64, y: i64| {
+            let (x, y) = (self.wrap_u.index(x, self.width), self.wrap_v.index(y, self.height));
+            self.alpha[y * self.width as usize + x] as f32 / 255.0
+        };
+        let top = at(x0, y0) * (1.0 - fx) + at(x0 + 1, y0) * fx;
+        let bottom = at(x0, y0 + 1) * (1.0 - fx) + at(x0 + 1, y0 + 1) * fx;
+        top * (1.0 - fy) + bottom * fy
+    }
+
+    /// The texel at the upper left of the four that (u, v) (finite) lies
+    /// between, and its fractions of the way to the next along x and y.
+    #[inline]
+    fn footprint(&self, u: f32, v: f32) -> (i64, i64, f32, f32) {
+        // f64: a coordinate of 1e6 still resolves a texel of a 16k image.
+        let x = u as f64 * self.width as f64 - 0.5;
+        let y = v as f64 * self.height as f64 - 0.5;
+        // Beyond 2⁵² a float has no fraction left; held there, the texel
+        // indices and their neighbours stay within i64 (u = 3e38 is a
+        // texture coordinate a file may hold).
+        const FAR: f64 = (1u64 << 52) as f64;
+        let (x, y) = (x.clamp(-FAR, FAR), y.clamp(-FAR, FAR));
+        let (x0, y0) = (x.floor(), y.floor());
+        ((x0 as i64), (y0 as i64), (x - x0) as f32, (y - y0) as f32)
     }
 
     /// The same texels read as data, each byte over 255, not as sRGB
@@ -151,8 +209,9 @@ impl Texture {
         (sum / self.texels.len() as f64).as_vec3()
     }
 
-    /// Decodes a PNG or JPEG image; alpha is dropped and 16-bit channels
-    /// are reduced to 8 bits. `max_pixels` bounds the image's size.
+    /// Decodes a PNG or JPEG image; 16-bit channels are reduced to 8 bits,
+    /// and an alpha channel is kept as the texels' coverage
+    /// ([`Texture::alpha`]). `max_pixels` bounds the image's size.
     pub fn decode(bytes: &[u8], max_pixels: u64) -> Result<Texture, String> {
         let format = match image::guess_format(bytes) {
             Ok(f @ (image::ImageFormat::Png | image::ImageFormat::Jpeg)) => f,
@@ -170,12 +229,20 @@ impl Texture {
         let mut reader = image::ImageReader::with_format(std::io::Cursor::new(bytes), format);
         reader.limits(image::Limits::no_limits());
         // The decoded image (16-bit RGBA takes 8 bytes a pixel), its 8-bit
-        // RGB copy and the texels, counted before the decoder allocates.
+        // RGB(A) copy and the texels with their alpha, counted before the
+        // decoder allocates.
         let decoder = reader.into_decoder().map_err(|e| format!("cannot read the image: {e}"))?;
         let decoded = image::ImageDecoder::total_bytes(&decoder);
-        let needed = decoded.saturating_add(width as u64 * height as u64 * 6);
+        let needed = decoded.saturating_add(width as u64 * height as u64 * 8);
         crate::memory::check(format!("decoding a {width}×{height} texture"), needed).map_err(|e| e.to_string())?;
         let image = image::DynamicImage::from_decoder(decoder).map_err(|e| format!("cannot decode the image: {e}"))?;
+        if image.color().has_alpha() {
+            let rgba = image.into_rgba8();
+            let texels = rgba.pixels().map(|p| [p.0[0], p.0[1], p.0[2]]).collect();
+            let alpha = rgba.pixels().map(|p| p.0[3]).collect();
+            let texture = Texture::from_srgb8(width, height, texels).ok_or_else(|| "the image is empty".to_string())?;
+            return texture.with_alpha(alpha).ok_or_else(|| "the image is empty".to_string());
+        }
         let rgb = image.into_rgb8();
         let texels = rgb.pixels().map(|p| p.0).collect();
         Texture::from_srgb8(width, height, texels).ok_or_else(|| "the image is empty".to_string())
@@ -213,17 +280,7 @@ impl Texture {
         if !(u.is_finite() && v.is_finite()) {
             return self.mean;
         }
-        // f64: a coordinate of 1e6 still resolves a texel of a 16k image.
-        let x = u as f64 * self.width as f64 - 0.5;
-        let y = v as f64 * self.height as f64 - 0.5;
-        // Beyond 2⁵² a float has no fraction left; held there, the texel
-        // indices and their neighbours stay within i64 (u = 3e38 is a
-        // texture coordinate a file may hold).
-        const FAR: f64 = (1u64 << 52) as f64;
-        let (x, y) = (x.clamp(-FAR, FAR), y.clamp(-FAR, FAR));
-        let (x0, y0) = (x.floor(), y.floor());
-        let (fx, fy) = ((x - x0) as f32, (y - y0) as f32);
-        let (x0, y0) = (x0 as i64, y0 as i64);
+        let (x0, y0, fx, fy) = self.footprint(u, v);
         let top = self.texel(x0, y0) * (1.0 - fx) + self.texel(x0 + 1, y0) * fx;
         let bottom = self.texel(x0, y0 + 1) * (1.0 - fx) + self.texel(x0 + 1, y0 + 1) * fx;
         top * (1.0 - fy) + bottom * fy

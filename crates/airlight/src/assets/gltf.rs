@@ -14,7 +14,7 @@ use super::{Loader, MAX_MESH_BYTES, read_limited};
 use crate::camera::Camera;
 use crate::geometry::Shape;
 use crate::light::{Attenuation, Light, SpotProfile};
-use crate::material::{Material, MetallicRoughness, SurfaceMaps, TextureMap, UvTransform};
+use crate::material::{AlphaMode, Cutout, Material, MetallicRoughness, SurfaceMaps, TextureMap, UvTransform};
 use crate::scene::{Parts, TexturedEmission, limits};
 use crate::texture::{Texture, Wrap};
 use base64::Engine;
@@ -276,6 +276,9 @@ impl Loader<'_> {
                     if !out.parts.materials.iter().any(|(n, _)| *n == name) {
                         let m = self.gltf_material(&material, textures)?;
                         out.parts.materials.push((name.clone(), m));
+                        if let Some(cutout) = self.gltf_cutout(&material, textures)? {
+                            out.parts.cutouts.push((name.clone(), cutout));
+                        }
                     }
                     name
                 }
@@ -357,6 +360,39 @@ impl Loader<'_> {
             specular,
             maps: has_maps.then(|| Arc::new(maps)),
         }))
+    }
+}
+
+impl Loader<'_> {
+    /// A material's cut-out: its `alphaMode` MASK (with `alphaCutoff`) or
+    /// BLEND over the base colour's alpha, factor × texture; None for OPAQUE.
+    fn gltf_cutout(&self, material: &gltf::Material, textures: &mut Textures) -> Result<Option<Cutout>, String> {
+        use gltf::material::AlphaMode as Gltf;
+        let at = material.index().map_or("the default material".to_string(), |i| format!("materials[{i}]"));
+        let mode = match material.alpha_mode() {
+            Gltf::Opaque => return Ok(None),
+            Gltf::Blend => AlphaMode::Blend,
+            Gltf::Mask => {
+                let cutoff = material.alpha_cutoff().unwrap_or(0.5);
+                if !(cutoff.is_finite() && cutoff >= 0.0) {
+                    return Err(format!("{at}: its alphaCutoff is {cutoff}, not a number ≥ 0"));
+                }
+                AlphaMode::Mask { cutoff }
+            }
+        };
+        let pbr = material.pbr_metallic_roughness();
+        let factor = pbr.base_color_factor()[3];
+        if !(0.0..=1.0).contains(&factor) {
+            return Err(format!("{at}: its base colour's alpha is {factor}, not in [0, 1]"));
+        }
+        let map = match pbr.base_color_texture() {
+            Some(info) => Some(
+                self.gltf_map(textures, &info, "pbrMetallicRoughness.baseColorTexture", false)
+                    .map_err(|why| format!("{at}.{why}"))?,
+            ),
+            None => None,
+        };
+        Ok(Some(Cutout { factor, map, mode }))
     }
 }
 
@@ -472,8 +508,6 @@ fn not_read(doc: &serde_json::Value) -> Vec<String> {
             notes.push(format!("{what} ({of}) not read: {instead}"));
         }
     };
-    let cut_out = |m: &Value| m.get("alphaMode").and_then(Value::as_str).is_some_and(|a| a != "OPAQUE");
-    note(count(&cut_out), "alphaMode MASK or BLEND", "cut-outs and glass are opaque");
     note(count(&|m| m.get("normalTexture").is_some()), "normal maps", "surfaces are shaded by their triangles");
     // KHR_materials_specular's factor is read; its colour and textures not.
     let specular = |m: &Value| {
@@ -857,7 +891,6 @@ mod tests {
         assert_eq!(
             not_read(&doc),
             [
-                "alphaMode MASK or BLEND (1 material) not read: cut-outs and glass are opaque",
                 "normal maps (1 material) not read: surfaces are shaded by their triangles",
                 "KHR_materials_specular colours and textures (1 material) not read: only its specularFactor weighs the lobe",
                 "a second texture coordinate set (1 material) not read: the metallic-roughness map reads the base colour's",

@@ -30,7 +30,10 @@ impl Loader<'_> {
     pub(crate) fn texture_bytes(&self, bytes: &[u8], what: &str) -> Result<Texture, String> {
         let texture = Texture::decode(bytes, MAX_TEXTURE_PIXELS)?;
         let (w, h) = texture.size();
-        self.reserve(w as u64 * h as u64 * 3, || format!("the scene's meshes and textures ({w}×{h} in {what})"))?;
+        let per_texel = if texture.has_alpha() { 4 } else { 3 };
+        self.reserve(w as u64 * h as u64 * per_texel, || {
+            format!("the scene's meshes and textures ({w}×{h} in {what})")
+        })?;
         Ok(texture)
     }
 }

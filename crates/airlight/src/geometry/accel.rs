@@ -11,6 +11,7 @@ use super::blocks::{TriangleBlock, into_blocks};
 use super::bvh::Bvh8;
 use super::collapse::{CollapseCosts, TreeShape, collapse};
 use super::lanes::LaneWidth;
+use super::ray::offset_origin;
 use super::records::{
     Instance, NO_ATTRIBUTES, PlaneRecord, Prim, Record, SdfPrim, TriangleAttributes, UNBOUNDED_FAR, UnboundedSdf,
     barycentric, intersect_plane,
@@ -18,6 +19,7 @@ use super::records::{
 use super::sdf::sphere_trace;
 use super::shape::Shape;
 use super::small::{RAYS, RayLanes, Small, small_scene};
+use crate::material::Cutout;
 use glam::{Mat3, Vec2, Vec3, Vec3A};
 use obvhs::{BvhBuildParams, aabb::Aabb};
 use std::time::Duration;
@@ -87,6 +89,8 @@ pub struct Geometry {
     bounds: Option<(Vec3, Vec3)>,
     /// The texture coordinates of the triangles that have them.
     triangle_attributes: Vec<TriangleAttributes>,
+    /// Per material index: its cut-out, if it has one ([`Geometry::set_cutouts`]).
+    cutouts: Vec<Option<Cutout>>,
 }
 
 /// Up to this many primitives are tested one by one, without the BVH: the
@@ -109,6 +113,10 @@ impl std::fmt::Debug for Geometry {
             .finish()
     }
 }
+
+/// Most cut-outs a ray goes through before the next surface is taken as a
+/// hit whatever it is (a ray along a stack of leaves).
+const MAX_CUTOUT_LAYERS: usize = 64;
 
 /// Collects shapes; `build` makes the BVH.
 #[derive(Default)]
@@ -244,7 +252,17 @@ impl GeometryBuilder {
         }
         let blocks = into_blocks(&mut bvh, &records);
         let small = small_scene(&records);
-        Geometry { records, planes, unbounded, blocks, bvh: Some(bvh), small, bounds, triangle_attributes }
+        Geometry {
+            records,
+            planes,
+            unbounded,
+            blocks,
+            bvh: Some(bvh),
+            small,
+            bounds,
+            triangle_attributes,
+            cutouts: Vec::new(),
+        }
     }
 }
 
@@ -272,12 +290,66 @@ impl Geometry {
         self.intersect_on(LaneWidth::widest(), ray, tmax)
     }
 
+    /// Gives the materials' cut-outs, by material index: hits on them where
+    /// rays pass ([`Cutout::passes`]) are gone through.
+    pub fn set_cutouts(&mut self, cutouts: Vec<Option<Cutout>>) {
+        self.cutouts = if cutouts.iter().any(Option::is_some) { cutouts } else { Vec::new() };
+    }
+
+    /// Whether some material is cut out.
+    pub fn has_cutouts(&self) -> bool {
+        !self.cutouts.is_empty()
+    }
+
+    /// Whether `ray` goes through the hit `hit` (a cut-out open there).
+    fn passes(&self, ray: &Ray, hit: Hit) -> bool {
+        let Some(rec) = self.records.get(hit.id as usize) else { return false };
+        let Some(Some(cutout)) = self.cutouts.get(rec.material as usize) else { return false };
+        let p = ray.at(hit.t);
+        // The ray's own number for a blend: a hash of where it meets the
+        // surface and where it goes, the same on every run.
+        let bits = |v: Vec3| [v.x.to_bits(), v.y.to_bits(), v.z.to_bits()];
+        let [a, b, c] = bits(p);
+        let [d, e, f] = bits(ray.dir);
+        let key = ((a as u64) << 32 | b as u64) ^ ((c as u64) << 32 | d as u64).rotate_left(17);
+        let u = crate::sampling::keyed2(key, (e as u64) << 32 | f as u64).x;
+        cutout.passes(self.uv_at(rec, p), u)
+    }
+
+    /// The nearest hit not in a cut-out's open part: the nearest hit, and
+    /// while a cut-out lets the ray through there, the nearest beyond it
+    /// from just past the surface (at most [`MAX_CUTOUT_LAYERS`] times; the
+    /// last is then taken as a hit).
+    fn through_cutouts(&self, ray: &Ray, tmax: f32, nearest: impl Fn(&Ray, f32) -> Option<Hit>) -> Option<Hit> {
+        let mut from = *ray;
+        for _ in 0..MAX_CUTOUT_LAYERS {
+            let hit = nearest(&from, tmax - (from.origin - ray.origin).dot(ray.dir))?;
+            let total = Hit { t: (from.origin - ray.origin).dot(ray.dir) + hit.t, id: hit.id };
+            if !self.passes(&from, hit) {
+                return Some(total);
+            }
+            let p = from.at(hit.t);
+            let n = self.records[hit.id as usize].prim.normal(p);
+            from = Ray::new(offset_origin(p, n, ray.dir), ray.dir);
+        }
+        nearest(&from, tmax - (from.origin - ray.origin).dot(ray.dir))
+            .map(|hit| Hit { t: (from.origin - ray.origin).dot(ray.dir) + hit.t, id: hit.id })
+    }
+
     /// [`Geometry::intersect`] with the tree's box and triangle tests on
     /// the given lanes, which the processor must have
     /// ([`LaneWidth::available`]; panics if not): for tests. One ray goes
     /// at most eight lanes wide (`Sixteen` takes eight).
     #[doc(hidden)]
     pub fn intersect_on(&self, lanes: LaneWidth, ray: &Ray, tmax: f32) -> Option<Hit> {
+        if self.has_cutouts() {
+            return self.through_cutouts(ray, tmax, |r, t| self.intersect_opaque_on(lanes, r, t));
+        }
+        self.intersect_opaque_on(lanes, ray, tmax)
+    }
+
+    /// [`Geometry::intersect_on`] with every surface opaque.
+    fn intersect_opaque_on(&self, lanes: LaneWidth, ray: &Ray, tmax: f32) -> Option<Hit> {
         let mut best = Hit { t: tmax, id: u32::MAX };
         if let Some(small) = &self.small {
             small.nearest(&self.records, ray.origin, ray.dir, tmax, &mut best);
@@ -309,8 +381,8 @@ impl Geometry {
     pub fn intersect_each(&self, rays: &[Ray], tmax: &[f32], hits: &mut [Option<Hit>]) {
         assert!(rays.len() == tmax.len() && rays.len() == hits.len(), "one bound and one hit slot per ray");
         match &self.small {
-            Some(small) => self.intersect_small_packets(small, rays, |i| tmax[i], hits),
-            None => {
+            Some(small) if !self.has_cutouts() => self.intersect_small_packets(small, rays, |i| tmax[i], hits),
+            _ => {
                 for ((ray, &tmax), hit) in rays.iter().zip(tmax).zip(hits.iter_mut()) {
                     *hit = self.intersect(ray, tmax);
                 }
@@ -386,6 +458,11 @@ impl Geometry {
         count_shadow_rays(1);
         if self.occluded_unbounded(origin, dir, tmax) {
             return true;
+        }
+        if self.has_cutouts() {
+            // Any hit may be an open part of a cut-out: the nearest, in turn.
+            let ray = Ray::new(origin, dir);
+            return self.through_cutouts(&ray, tmax, |r, t| self.intersect_opaque_on(lanes, r, t)).is_some();
         }
         if let Some(small) = &self.small {
             return small.any(&self.records, origin, dir, tmax);

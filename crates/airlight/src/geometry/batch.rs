@@ -76,6 +76,14 @@ impl Geometry {
     #[doc(hidden)]
     pub fn intersect_packet_on(&self, lanes: LaneWidth, rays: &[Ray], tmax: f32, hits: &mut [Option<Hit>]) {
         assert!(lanes.available(), "this processor has no {lanes:?} lanes");
+        if self.has_cutouts() {
+            // Each ray goes its own way through the cut-outs.
+            assert_eq!(rays.len(), hits.len(), "one hit slot per ray");
+            for (ray, hit) in rays.iter().zip(hits.iter_mut()) {
+                *hit = self.intersect_on(lanes, ray, tmax);
+            }
+            return;
+        }
         if let Some(small) = self.small() {
             assert_eq!(rays.len(), hits.len(), "one hit slot per ray");
             return self.intersect_small_packets(small, rays, |_| tmax, hits);
@@ -129,6 +137,12 @@ impl Geometry {
     #[doc(hidden)]
     pub fn occluded_packet_on(&self, lanes: LaneWidth, segments: &[Segment], blocked: &mut [bool]) {
         assert!(lanes.available(), "this processor has no {lanes:?} lanes");
+        if self.has_cutouts() {
+            for (s, b) in segments.iter().zip(blocked.iter_mut()) {
+                *b = self.occluded_on(lanes, s.origin, s.dir, s.tmax);
+            }
+            return;
+        }
         match lanes {
             LaneWidth::Portable => self.occluded_packet_with::<Scalar4>(segments, blocked),
             LaneWidth::Four => self.occluded_packet_with::<NativeLanes>(segments, blocked),

@@ -1,9 +1,11 @@
 //! Surface materials. All reflect on both sides (docs/scene-format.md: two-sided).
 
+pub mod cutout;
 pub mod metallic_roughness;
 pub mod microfacet;
 pub mod shading;
 
+pub use cutout::{AlphaMode, Cutout};
 pub use metallic_roughness::{MetallicRoughness, SurfaceMaps, TextureMap, UvTransform};
 
 use crate::Rgb;

@@ -7,7 +7,7 @@ use super::{LightCulling, RenderSettings, Scene, SceneError, default_camera, geo
 use crate::camera::Camera;
 use crate::geometry::{Geometry, Shape};
 use crate::light::{Keyframes, Light};
-use crate::material::Material;
+use crate::material::{Cutout, Material};
 use crate::medium::Medium;
 use glam::{Affine3A, Vec3};
 use std::collections::HashMap;
@@ -23,6 +23,8 @@ pub(crate) struct Parts {
     /// The emission of the lights of `lights` (by index) whose radiance
     /// varies over them.
     pub textured: Vec<(usize, TexturedEmission)>,
+    /// The cut-outs of the materials of `materials` (by name) that have one.
+    pub cutouts: Vec<(String, Cutout)>,
 }
 
 /// Builds a [`Scene`] in Rust, as a World/Camera example in a tutorial would.
@@ -36,6 +38,8 @@ pub struct SceneBuilder {
     lights: Vec<Light>,
     light_paths: Vec<Option<Keyframes>>,
     textured: Vec<(usize, TexturedEmission)>,
+    /// Cut-outs by material name.
+    cutouts: HashMap<String, Cutout>,
     medium: Option<Medium>,
 }
 
@@ -65,6 +69,9 @@ impl SceneBuilder {
     pub(crate) fn parts(self, parts: Parts) -> Self {
         let builder = parts.materials.into_iter().fold(self, |b, (name, m)| b.material(&name, m));
         let mut builder = parts.objects.into_iter().fold(builder, |b, (shape, name)| b.object(shape, &name));
+        for (name, cutout) in parts.cutouts {
+            builder = builder.cutout(&name, cutout);
+        }
         let offset = builder.lights.len();
         builder.textured.extend(parts.textured.into_iter().map(|(i, e)| (offset + i, e)));
         parts.lights.into_iter().fold(builder, SceneBuilder::light)
@@ -109,6 +116,12 @@ impl SceneBuilder {
         self
     }
 
+    /// Makes the material `name` a cut-out (see [`Cutout`]).
+    pub fn cutout(mut self, name: &str, cutout: Cutout) -> Self {
+        self.cutouts.insert(name.to_string(), cutout);
+        self
+    }
+
     pub fn medium(mut self, medium: Medium) -> Self {
         self.medium = Some(medium);
         self
@@ -125,8 +138,16 @@ impl SceneBuilder {
             lights,
             light_paths,
             textured,
+            cutouts: cutouts_by_name,
             medium,
         } = self;
+        let mut cutouts = vec![None; materials.len()];
+        for (name, cutout) in cutouts_by_name {
+            let Some(&index) = material_names.get(&name) else {
+                return Err(SceneError::new(format!("a cut-out of unknown material `{name}`")));
+            };
+            cutouts[index as usize] = Some(cutout);
+        }
         let mut light_emission: Vec<Option<Box<TexturedEmission>>> = vec![None; lights.len()];
         for (i, e) in textured {
             if let Some(slot) = light_emission.get_mut(i) {
@@ -159,6 +180,7 @@ impl SceneBuilder {
             lights,
             light_paths,
             light_emission,
+            cutouts: cutouts.clone(),
             medium: medium.filter(|m| !m.is_vacuum()),
             objects: placed,
             geometry: Geometry::default(),
@@ -182,6 +204,7 @@ impl SceneBuilder {
             )));
         }
         scene.geometry = geometry.build();
+        scene.geometry.set_cutouts(cutouts);
         scene.update_bounds();
         scene.check_medium_depth().map_err(SceneError::new)?;
         Ok(scene)

@@ -52,6 +52,9 @@ pub struct Scene {
     /// Per light: its emission where it varies over the light (an
     /// emissive texture; see [`Scene::emitted`]).
     light_emission: Vec<Option<Box<TexturedEmission>>>,
+    /// Per material index: its cut-out, if any (glTF's alpha), which the
+    /// geometry lets rays through.
+    cutouts: Vec<Option<crate::material::Cutout>>,
     /// Never a vacuum: a medium that neither absorbs nor scatters is none.
     medium: Option<Medium>,
     /// The scene's objects (not the lights' surfaces), in world space, with
@@ -126,6 +129,11 @@ impl Scene {
         self.materials.get(index as usize).unwrap_or(&Material::BLACK)
     }
 
+    /// Whether some material is cut out (has a coverage rays pass through).
+    pub fn has_cutouts(&self) -> bool {
+        self.cutouts.iter().any(Option::is_some)
+    }
+
     /// The normal a hit is shaded with when it is not its surface's own: a
     /// mesh's vertex normals interpolated (see [`crate::material::shading`]).
     #[inline]
@@ -192,7 +200,9 @@ impl Scene {
     /// A BVH of the objects alone, without the lights' surfaces: for what is
     /// computed once while lights move (the viewer's cached camera hits).
     pub fn objects_geometry(&self) -> Geometry {
-        build_geometry(self.surfaces().filter(|s| s.emitter.is_none()))
+        let mut geometry = build_geometry(self.surfaces().filter(|s| s.emitter.is_none()));
+        geometry.set_cutouts(self.cutouts.clone());
+        geometry
     }
 
     /// Centre and radius of a sphere around the bounded geometry, the lights
@@ -264,6 +274,7 @@ impl Scene {
         self.skies = skies(&self.lights);
         if surfaces_moved {
             self.geometry = build_geometry(self.surfaces());
+            self.geometry.set_cutouts(self.cutouts.clone());
         }
         self.update_bounds();
         surfaces_moved

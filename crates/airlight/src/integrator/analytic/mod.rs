@@ -220,6 +220,12 @@ impl Analytic {
                         use raymarch or stochastic, or render without shadows"
                 .into());
         }
+        if options.shadows && scene.has_cutouts() {
+            return Err("the analytic integrator's exact shadow boundaries are the occluders' edges and cannot \
+                        follow a texture's alpha (this scene has cut-out materials, glTF's alphaMode MASK or \
+                        BLEND): use raymarch or stochastic, or render without shadows"
+                .into());
+        }
         if let Some(m) = scene.medium() {
             let kind = match m.density {
                 Density::Homogeneous => None,
