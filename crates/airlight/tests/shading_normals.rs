@@ -85,3 +85,50 @@ fn smooth_normals_on_a_tessellated_sphere_shade_it_as_the_sphere() {
     let e_path = error(&smooth, &path, 16);
     assert!(e_path < 0.01, "path: mean error {e_path}");
 }
+
+/// A normal map of one texel that tilts the normal by about 30° toward
+/// the quad's u direction and 15° up its image shades the quad as a quad
+/// tilted so: the same radiance under a sun, for the normal the texel
+/// decodes to (a bitangent of the wrong sign would tilt it the other way).
+#[test]
+fn a_normal_map_of_constant_tilt_shades_as_the_tilted_surface() {
+    let dir = tempfile::tempdir().unwrap();
+    let texel = [191u8, 160, 230];
+    let mut png = Vec::new();
+    let encoder = image::codecs::png::PngEncoder::new(&mut png);
+    image::ImageEncoder::write_image(encoder, &texel, 1, 1, image::ExtendedColorType::Rgb8).unwrap();
+    std::fs::write(dir.path().join("tilt.png"), png).unwrap();
+    // The quad faces +y; its u runs along +x (the tangent) and its v
+    // along +z, down the image, so the bitangent (up the image) is −z.
+    let c = Vec3::from_array(texel.map(|b| 2.0 * b as f32 / 255.0 - 1.0));
+    let tilted = (Vec3::X * c.x + Vec3::NEG_Z * c.y + Vec3::Y * c.z).normalize();
+    let material = "type = \"metallic_roughness\"\nbase_colour = 0.7\nspecular = 0\nmetallic = 0";
+    let sun = "[[lights]]\ntype = \"distant\"\ndirection = [0.8, -1, 0.1]\nirradiance = 2";
+    let mapped = format!(
+        "[materials.m]\n{material}\nnormal_file = \"tilt.png\"\n[[objects]]\ntype = \"quad\"\n\
+         corner = [-1, 0, 1]\nedge_u = [2, 0, 0]\nedge_v = [0, 0, -2]\nmaterial = \"m\"\n{sun}\n"
+    );
+    // The same quad turned to face `tilted`.
+    let (t, b) = airlight::sampling::basis(tilted);
+    let (eu, ev) = (t * 2.0, b * 2.0);
+    let corner = -0.5 * (eu + ev);
+    let toml3 = |v: Vec3| format!("[{}, {}, {}]", v.x, v.y, v.z);
+    let geometric = format!(
+        "[materials.m]\n{material}\n[[objects]]\ntype = \"quad\"\ncorner = {}\nedge_u = {}\nedge_v = {}\n\
+         material = \"m\"\n{sun}\n",
+        toml3(corner),
+        toml3(eu),
+        toml3(ev)
+    );
+    let radiance = |text: &str| {
+        let file = airlight::SceneFile::from_toml_str(text, Some(dir.path())).unwrap_or_else(|e| panic!("{e}"));
+        let ray = Ray::new(vec3(0.05, 3.0, 0.02), Vec3::NEG_Y);
+        Direct.radiance(&file.scene, &ray, &mut Sampler::for_pixel(0, 0, 0))
+    };
+    let (a, b) = (radiance(&mapped), radiance(&geometric));
+    assert!(b.x > 0.1, "{b}");
+    assert!((a - b).abs().max_element() < 1e-4 * b.max_element(), "mapped {a} against tilted {b}");
+    // Without the map, the flat quad: a different value.
+    let flat = radiance(&mapped.replace("normal_file = \"tilt.png\"\n", ""));
+    assert!((flat - b).abs().max_element() > 0.05 * b.max_element(), "flat {flat} against tilted {b}");
+}

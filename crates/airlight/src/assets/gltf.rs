@@ -298,7 +298,8 @@ impl Loader<'_> {
 fn uv_set(material: &gltf::Material) -> Option<u32> {
     let pbr = material.pbr_metallic_roughness();
     let set = |info: gltf::texture::Info| info_set(&info);
-    pbr.base_color_texture().map(set).or_else(|| pbr.metallic_roughness_texture().map(set))
+    let normal = || material.normal_texture().map(|n| n.tex_coord());
+    pbr.base_color_texture().map(set).or_else(|| pbr.metallic_roughness_texture().map(set)).or_else(normal)
 }
 
 impl Loader<'_> {
@@ -330,10 +331,26 @@ impl Loader<'_> {
         let metallic = unit(pbr.metallic_factor(), "metallicFactor")?;
         let roughness = unit(pbr.roughness_factor(), "roughnessFactor")?;
         let specular = unit(material.specular().map_or(1.0, |s| s.specular_factor()), "specularFactor")?;
+        // A normal map (its KHR_texture_transform, which the crate does
+        // not give for normal textures, is not read).
+        let normal = match material.normal_texture() {
+            Some(n) => {
+                let scale = n.scale();
+                if !scale.is_finite() {
+                    return Err(format!("{at}.normalTexture: its scale is {scale}"));
+                }
+                let texture = self
+                    .gltf_texture(textures, &n.texture(), true)
+                    .map_err(|why| format!("{at}.normalTexture: {why}"))?;
+                Some((TextureMap::new(texture), scale))
+            }
+            None => None,
+        };
         let mut map = |info: Option<gltf::texture::Info>, what: &str, data: bool| {
             info.map(|info| self.gltf_map(textures, &info, what, data).map_err(|why| format!("{at}.{why}"))).transpose()
         };
         let maps = SurfaceMaps {
+            normal,
             base_colour: map(pbr.base_color_texture(), "pbrMetallicRoughness.baseColorTexture", false)?,
             metallic_roughness: map(
                 pbr.metallic_roughness_texture(),
@@ -341,18 +358,18 @@ impl Loader<'_> {
                 true,
             )?,
         };
-        if metallic == 0.0 && specular == 0.0 && maps.metallic_roughness.is_none() {
+        if metallic == 0.0 && specular == 0.0 && maps.metallic_roughness.is_none() && maps.normal.is_none() {
             return Ok(match maps.base_colour {
                 Some(m) if m.transform == UvTransform::IDENTITY => Material::textured(base, m.texture),
                 Some(m) => {
-                    let maps = SurfaceMaps { base_colour: Some(m), metallic_roughness: None };
+                    let maps = SurfaceMaps { base_colour: Some(m), metallic_roughness: None, normal: None };
                     let lambertian = MetallicRoughness::lambertian(base);
                     Material::MetallicRoughness(MetallicRoughness { maps: Some(Arc::new(maps)), ..lambertian })
                 }
                 None => Material::diffuse(base),
             });
         }
-        let has_maps = maps.base_colour.is_some() || maps.metallic_roughness.is_some();
+        let has_maps = maps.base_colour.is_some() || maps.metallic_roughness.is_some() || maps.normal.is_some();
         Ok(Material::MetallicRoughness(MetallicRoughness {
             base,
             metallic,
@@ -508,7 +525,12 @@ fn not_read(doc: &serde_json::Value) -> Vec<String> {
             notes.push(format!("{what} ({of}) not read: {instead}"));
         }
     };
-    note(count(&|m| m.get("normalTexture").is_some()), "normal maps", "surfaces are shaded by their triangles");
+    let moved_normal = |m: &Value| {
+        m.get("normalTexture")
+            .and_then(|n| n.get("extensions"))
+            .is_some_and(|e| e.get("KHR_texture_transform").is_some())
+    };
+    note(count(&moved_normal), "a normal map's KHR_texture_transform", "the map is read untransformed");
     // KHR_materials_specular's factor is read; its colour and textures not.
     let specular = |m: &Value| {
         m.get("extensions").and_then(|e| e.get("KHR_materials_specular")).is_some_and(|s| {
@@ -891,7 +913,6 @@ mod tests {
         assert_eq!(
             not_read(&doc),
             [
-                "normal maps (1 material) not read: surfaces are shaded by their triangles",
                 "KHR_materials_specular colours and textures (1 material) not read: only its specularFactor weighs the lobe",
                 "a second texture coordinate set (1 material) not read: the metallic-roughness map reads the base colour's",
                 "the extension KHR_materials_sheen not read",

@@ -574,6 +574,29 @@ impl Geometry {
         (n0 * (1.0 - b1 - b2) + n1 * b1 + n2 * b2).try_normalize()
     }
 
+    /// How the surface moves with its texture coordinates at a hit, ∂p/∂u
+    /// and ∂p/∂v (constant over a triangle; a quad's are its edges, u
+    /// along edge_u and v against edge_v); None without texture
+    /// coordinates or where they do not span the triangle.
+    pub fn uv_derivatives(&self, surface: &SurfaceHit) -> Option<(Vec3, Vec3)> {
+        let rec = self.records.get(surface.id as usize)?;
+        match rec.prim {
+            Prim::Triangle { e1, e2, .. } if rec.attributes != NO_ATTRIBUTES => {
+                let [t0, t1, t2] = self.triangle_attributes[rec.attributes as usize].uvs?;
+                let (d1, d2) = (t1 - t0, t2 - t0);
+                let det = d1.x * d2.y - d1.y * d2.x;
+                if det == 0.0 || !det.is_finite() {
+                    return None;
+                }
+                let dpdu = (e1 * d2.y - e2 * d1.y) / det;
+                let dpdv = (e2 * d1.x - e1 * d2.x) / det;
+                (dpdu.is_finite() && dpdv.is_finite()).then_some((dpdu, dpdv))
+            }
+            Prim::Quad { edge_u, edge_v, .. } => Some((edge_u, -edge_v)),
+            _ => None,
+        }
+    }
+
     /// The texture coordinates at point `p` of a record (see [`SurfaceHit::uv`]).
     fn uv_at(&self, rec: &Record, p: Vec3) -> Option<Vec2> {
         match rec.prim {

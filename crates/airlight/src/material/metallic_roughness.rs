@@ -53,6 +53,33 @@ pub struct SurfaceMaps {
     pub base_colour: Option<TextureMap>,
     /// Data: green multiplies the roughness, blue the metalness (glTF's layout).
     pub metallic_roughness: Option<TextureMap>,
+    /// A tangent-space normal map (data) and its scale (glTF's
+    /// `normalTexture`): see [`SurfaceMaps::mapped_normal`].
+    pub normal: Option<(TextureMap, f32)>,
+}
+
+impl SurfaceMaps {
+    /// The shading normal the normal map gives at `uv`, about the normal
+    /// `n` (the vertex normals' or the triangle's) with the surface's
+    /// texture derivatives `dpdu`, `dpdv`: the texel (r, g, b) read as the
+    /// tangent-space vector (2r − 1, 2g − 1, 2b − 1), its x and y times
+    /// the scale, in the frame of the tangent t (∂p/∂u made perpendicular
+    /// to n), the bitangent ±n × t on the side of −∂p/∂v, and n. glTF's
+    /// normal maps have +x along u and +y up the image, and its v runs down
+    /// the image. The frame is the triangle's (tangents per triangle from
+    /// its texture coordinates, not MikkTSpace's per vertex: seams between
+    /// triangles of different mappings can show). None without a normal
+    /// map or where the frame degenerates.
+    pub fn mapped_normal(&self, uv: Vec2, n: Vec3, dpdu: Vec3, dpdv: Vec3) -> Option<Vec3> {
+        let (map, scale) = self.normal.as_ref()?;
+        let t = (dpdu - n * n.dot(dpdu)).try_normalize()?;
+        // glTF's tangent space: +x along u, +y along v pointing up the
+        // image, which is −∂p/∂v (v runs down the image), made right-handed
+        // or left-handed as the texture's mapping is.
+        let b = n.cross(t) * if n.cross(t).dot(-dpdv) < 0.0 { -1.0 } else { 1.0 };
+        let c = map.sample(uv) * 2.0 - Vec3::ONE;
+        (t * (c.x * scale) + b * (c.y * scale) + n * c.z).try_normalize()
+    }
 }
 
 /// A texture as a material reads it: through a transform of the surface's

@@ -136,9 +136,20 @@ impl Scene {
 
     /// The normal a hit is shaded with when it is not its surface's own: a
     /// mesh's vertex normals interpolated (see [`crate::material::shading`]).
+    /// A normal map's normal where its material has one (see
+    /// [`crate::material::SurfaceMaps::mapped_normal`]).
     #[inline]
     pub fn shading_normal(&self, surface: &SurfaceHit) -> Option<Vec3> {
-        self.geometry.vertex_normal(surface)
+        let vertex = self.geometry.vertex_normal(surface);
+        if let Material::MetallicRoughness(m) = self.material(surface.material)
+            && let Some(maps) = &m.maps
+            && maps.normal.is_some()
+            && let Some(uv) = self.geometry.uv(surface)
+            && let Some((dpdu, dpdv)) = self.geometry.uv_derivatives(surface)
+        {
+            return maps.mapped_normal(uv, vertex.unwrap_or(surface.n), dpdu, dpdv).or(vertex);
+        }
+        vertex
     }
 
     /// The material at a hit, a texture looked up at its texture

@@ -171,7 +171,9 @@ pub(crate) struct NoiseMedium {
 }
 
 tagged! {
-    /// One `[materials.NAME]` table, by its `type`.
+    /// One `[materials.NAME]` table, by its `type`. (Read once per
+    /// material: the metallic-roughness variant's size costs nothing.)
+    #[allow(clippy::large_enum_variant)]
     pub(crate) enum MaterialDesc {
         tag: "type", family: ("material", "materials"), default: Some("diffuse"), shared: NoShared,
         Diffuse(DiffuseMaterial) = "diffuse",
@@ -227,6 +229,10 @@ pub(crate) struct MetallicRoughnessMaterial {
     pub base_colour_file: Option<Spanned<String>>,
     /// Data: green multiplies `roughness`, blue `metallic`.
     pub metallic_roughness_file: Option<Spanned<String>>,
+    /// A tangent-space normal map (data), glTF's convention.
+    pub normal_file: Option<Spanned<String>>,
+    /// The normal map's x and y scale.
+    pub normal_scale: Option<Spanned<f32>>,
     /// `repeat`, `clamp` or `mirror`, for both images.
     pub wrap: Option<Spanned<String>>,
 }

@@ -52,11 +52,19 @@ impl Checker<'_> {
                         .map(|f| self.image(&label, field, f, m.wrap.as_ref(), data).map(TextureMap::new))
                         .transpose()
                 };
+                let normal_scale = match &m.normal_scale {
+                    Some(s) if !s.get_ref().is_finite() => {
+                        return Err(self.err(s.span(), format!("{}: expected a finite number", what("normal_scale"))));
+                    }
+                    Some(s) => *s.get_ref(),
+                    None => 1.0,
+                };
                 let maps = SurfaceMaps {
+                    normal: image(&m.normal_file, "normal_file", true)?.map(|map| (map, normal_scale)),
                     base_colour: image(&m.base_colour_file, "base_colour_file", false)?,
                     metallic_roughness: image(&m.metallic_roughness_file, "metallic_roughness_file", true)?,
                 };
-                let has_maps = maps.base_colour.is_some() || maps.metallic_roughness.is_some();
+                let has_maps = maps.base_colour.is_some() || maps.metallic_roughness.is_some() || maps.normal.is_some();
                 Material::MetallicRoughness(MetallicRoughness {
                     base,
                     metallic: unit(&m.metallic, "metallic", 0.0)?,
