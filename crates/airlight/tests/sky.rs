@@ -128,3 +128,86 @@ fn a_model_alone_gets_a_sky_and_a_camera_and_says_so() {
     let included = SceneFile::from_toml_str(text, Some(dir.path())).unwrap();
     assert!(included.scene.notes().is_empty() && included.scene.lights().len() == 1);
 }
+
+/// An environment map (a Radiance HDR file): a diffuse ball facing the
+/// camera reflects albedo/π × ∫ L(ω) cos⁺ dω, the integral taken here by
+/// a fine quadrature over the sphere of the map's radiance (texel by
+/// texel, as the map defines it), through direct and path alike.
+#[test]
+fn a_ball_under_an_environment_map_reflects_its_integral() {
+    let (w, h) = (16usize, 8usize);
+    // A dim sky and a bright patch just above the horizon toward −z (the
+    // image's centre) and a little to +x, seen by the ball's front.
+    let radiance = |i: usize, j: usize| -> [f32; 3] {
+        if (8..10).contains(&i) && j == 3 { [30.0, 20.0, 10.0] } else { [0.3, 0.4, 0.5] }
+    };
+    let pixels: Vec<image::Rgb<f32>> = (0..w * h).map(|k| image::Rgb(radiance(k % w, k / w))).collect();
+    let dir = tempfile::tempdir().unwrap();
+    let file = std::fs::File::create(dir.path().join("sky.hdr")).unwrap();
+    image::codecs::hdr::HdrEncoder::new(file).encode(&pixels, w, h).unwrap();
+    // Radiance HDR stores shared-exponent values: read back what it holds.
+    let stored = image::open(dir.path().join("sky.hdr")).unwrap().into_rgb32f();
+    let texel = |i: usize, j: usize| glam::Vec3::from_array(stored.get_pixel(i as u32, j as u32).0);
+
+    let text = r#"
+[render]
+width = 8
+height = 8
+[camera]
+position = [0, 0, -4]
+look_at = [0, 0, 0]
+fov = 10
+[materials.ball]
+albedo = 0.5
+[[objects]]
+type = "sphere"
+center = [0, 0, 0]
+radius = 1
+material = "ball"
+[[lights]]
+type = "sky"
+file = "sky.hdr"
+radiance = 2
+"#;
+    let scene = SceneFile::from_toml_str(text, Some(dir.path())).unwrap_or_else(|e| panic!("{e}"));
+    // The quadrature: the normal at the ball's front is −z.
+    let n = glam::Vec3::NEG_Z;
+    let (steps_t, steps_p) = (400, 800);
+    let mut irradiance = glam::DVec3::ZERO;
+    for a in 0..steps_t {
+        let theta = std::f64::consts::PI * (a as f64 + 0.5) / steps_t as f64;
+        for b in 0..steps_p {
+            let phi = 2.0 * std::f64::consts::PI * ((b as f64 + 0.5) / steps_p as f64 - 0.5);
+            let d = glam::DVec3::new(theta.sin() * phi.sin(), theta.cos(), -theta.sin() * phi.cos());
+            let cos = d.dot(n.as_dvec3()).max(0.0);
+            let (i, j) = (
+                (((phi / (2.0 * std::f64::consts::PI)) + 0.5) * w as f64) as usize,
+                (theta / std::f64::consts::PI * h as f64) as usize,
+            );
+            let d_omega =
+                theta.sin() * (std::f64::consts::PI / steps_t as f64) * (2.0 * std::f64::consts::PI / steps_p as f64);
+            irradiance += texel(i.min(w - 1), j.min(h - 1)).as_dvec3() * 2.0 * cos * d_omega;
+        }
+    }
+    let expected = irradiance * 0.5 / std::f64::consts::PI;
+    for kind in [IntegratorKind::Direct, IntegratorKind::Path] {
+        let mut desc = IntegratorDesc::new(kind);
+        desc.path.max_depth = 1;
+        let integrator = desc.build(&scene.scene).unwrap();
+        let acc = accumulate(&scene.scene, integrator.as_ref(), 0..2048, 3..5, &Default::default());
+        let mut got = glam::DVec3::ZERO;
+        for (x, y) in [(3, 3), (4, 3), (3, 4), (4, 4)] {
+            got += acc.pixel(x, y).unwrap().mean().as_dvec3() / 4.0;
+        }
+        for c in 0..3 {
+            assert!((got[c] / expected[c] - 1.0).abs() < 0.03, "{kind:?}: {got} against the quadrature's {expected}");
+        }
+    }
+    // Seen directly, looking away from the ball along −z (the image's
+    // centre column, at the horizon: texel (8, 4)): the map times its scale.
+    use airlight::integrator::Integrator;
+    let ray = airlight::geometry::Ray::new(glam::Vec3::new(0.0, 0.0, -4.0), glam::Vec3::NEG_Z);
+    let seen =
+        airlight::integrator::Direct.radiance(&scene.scene, &ray, &mut airlight::sampling::Sampler::for_pixel(0, 0, 0));
+    assert_eq!(seen, texel(8, 4) * 2.0);
+}

@@ -60,8 +60,9 @@ pub struct RenderArgs {
     /// `type="height",sigma_s=0.2,falloff=0.5`; `none` for no medium.
     #[arg(long, value_name = "KEY=VALUE,...", value_parser = parse_medium)]
     pub(super) medium: Option<MediumOption>,
-    /// A uniform sky instead of the scene's: its radiance, a number or
-    /// `[r,g,b]` (≥ 0); `none` for no sky.
+    /// The sky's radiance instead of the scene's (a uniform sky, or the
+    /// scale of its environment map): a number or `[r,g,b]` (≥ 0); `none`
+    /// for no sky.
     #[arg(long, value_name = "RADIANCE", value_parser = parse_sky)]
     pub(super) sky: Option<airlight::Rgb>,
     /// Worker threads (default: all cores). The image does not depend on it.

@@ -4,6 +4,7 @@
 //! materials use them.
 
 use super::{Loader, MAX_MESH_BYTES, read_limited};
+use crate::light::environment::{EnvironmentMap, environment_bytes};
 use crate::texture::Texture;
 use std::sync::Arc;
 
@@ -35,5 +36,51 @@ impl Loader<'_> {
             format!("the scene's meshes and textures ({w}×{h} in {what})")
         })?;
         Ok(texture)
+    }
+}
+
+/// Most texels an environment map may have (8192 × 4096: 640 MiB with its
+/// sampling tables).
+const MAX_ENVIRONMENT_PIXELS: u64 = 1 << 25;
+
+impl Loader<'_> {
+    /// The environment map in the image file `name` (found as a texture
+    /// is): a Radiance HDR (`.hdr`) or OpenEXR (`.exr`) image of linear
+    /// radiance, equirectangular ([`EnvironmentMap`]); or why not.
+    pub(crate) fn environment_file(&self, name: &str) -> Result<Arc<EnvironmentMap>, String> {
+        let path = self.resolve(name)?;
+        let fail = |why: String| format!("`{name}`: {why}");
+        let bytes = read_limited(&path, MAX_MESH_BYTES).map_err(fail)?;
+        let format = match image::guess_format(&bytes) {
+            Ok(f @ (image::ImageFormat::Hdr | image::ImageFormat::OpenExr)) => f,
+            Ok(other) => return Err(fail(format!("a {other:?} image; environment maps are Radiance HDR or OpenEXR"))),
+            Err(_) => return Err(fail("not a Radiance HDR or OpenEXR image".into())),
+        };
+        let reader = image::ImageReader::with_format(std::io::Cursor::new(&bytes), format);
+        let (width, height) = reader.into_dimensions().map_err(|e| fail(format!("cannot read the image: {e}")))?;
+        let texels = width as u64 * height as u64;
+        if texels > MAX_ENVIRONMENT_PIXELS {
+            return Err(fail(format!(
+                "{width}×{height} texels is more than the {MAX_ENVIRONMENT_PIXELS} an environment map may have"
+            )));
+        }
+        // The map with its tables, and the decoder's own image (up to
+        // 16 bytes a texel, RGBA in f32) while it is converted.
+        let needed = environment_bytes(width, height).saturating_add(texels.saturating_mul(16));
+        crate::memory::check(format!("decoding a {width}×{height} environment map"), needed)
+            .map_err(|e| fail(e.to_string()))?;
+        let mut reader = image::ImageReader::with_format(std::io::Cursor::new(&bytes), format);
+        let mut limits = image::Limits::default();
+        limits.max_alloc = Some(texels.saturating_mul(32).max(1 << 20));
+        reader.limits(limits);
+        let image = reader.decode().map_err(|e| fail(format!("cannot decode the image: {e}")))?;
+        let rgb = image.into_rgb32f();
+        let radiance = rgb.pixels().map(|p| glam::Vec3::from_array(p.0)).collect();
+        let map = EnvironmentMap::new(width, height, radiance)
+            .ok_or_else(|| fail("a texel is negative or not a number".into()))?;
+        self.reserve(environment_bytes(width, height), || format!("the environment map ({width}×{height})"))
+            .map_err(fail)?;
+        self.record(path);
+        Ok(Arc::new(map))
     }
 }

@@ -132,7 +132,7 @@ fn trace_batch(scene: &Scene, rays: &[Ray], samplers: &mut [Sampler], out: &mut 
         out[k] = match *hit {
             // What `surface_radiance` computes, with its shadow rays put off.
             Some(hit) => shadows.surface(scene, ray, &geometry.surface(ray, hit), sampler, k),
-            None => scene.escaped_radiance(),
+            None => scene.escaped_radiance(ray.dir),
         };
     }
     shadows.resolve(scene, None, out);

@@ -307,7 +307,7 @@ pub fn first_surface(
             let s = scene.geometry().surface(ray, hit);
             (surface_radiance(scene, ray, &s, sampler, medium) + extra(&s), hit.t)
         }
-        None => (scene.escaped_radiance(), scene.settings().max_distance),
+        None => (scene.escaped_radiance(ray.dir), scene.settings().max_distance),
     }
 }
 

@@ -3,6 +3,7 @@
 //! `intensity` per unit length (W/(sr·m)).
 
 mod attenuation;
+pub mod environment;
 mod keyframes;
 mod spot;
 mod volume;

@@ -324,7 +324,7 @@ impl Rows<'_> {
                 // A light's surface in front of the objects (it reflects nothing).
                 (Some(hit), _) => shadows.surface(scene, ray, &lights.surface(ray, *hit), sampler, k),
                 (None, Some(s)) => shadows.surface(scene, ray, s, sampler, k),
-                (None, None) => scene.escaped_radiance(),
+                (None, None) => scene.escaped_radiance(ray.dir),
             });
         }
         shadows.resolve(scene, scene.medium(), radiance);

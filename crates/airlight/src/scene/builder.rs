@@ -4,13 +4,16 @@
 use super::emitters::Emitters;
 use super::textured_emission::TexturedEmission;
 use super::{LightCulling, RenderSettings, Scene, SceneError, default_camera, geometry_of, limits, placed_delta};
+use crate::Rgb;
 use crate::camera::Camera;
 use crate::geometry::{Geometry, Shape};
+use crate::light::environment::EnvironmentMap;
 use crate::light::{Keyframes, Light};
 use crate::material::{Cutout, Material};
 use crate::medium::Medium;
 use glam::{Affine3A, Vec3};
 use std::collections::HashMap;
+use std::sync::Arc;
 
 /// What a scene file's object table or an included file adds to a scene:
 /// materials by name, surfaces with the names of their materials, and the
@@ -40,6 +43,8 @@ pub struct SceneBuilder {
     textured: Vec<(usize, TexturedEmission)>,
     /// Cut-outs by material name.
     cutouts: HashMap<String, Cutout>,
+    /// The sky light an environment map gives, by index, and the map.
+    sky_map: Option<(u32, Arc<EnvironmentMap>)>,
     medium: Option<Medium>,
 }
 
@@ -116,6 +121,13 @@ impl SceneBuilder {
         self
     }
 
+    /// A sky whose radiance is `scale` × the environment map's (see
+    /// [`EnvironmentMap`]); a scene has at most one.
+    pub fn environment(mut self, scale: Rgb, map: Arc<EnvironmentMap>) -> Self {
+        self.sky_map = Some((self.lights.len() as u32, map));
+        self.light(Light::sky(scale))
+    }
+
     /// Makes the material `name` a cut-out (see [`Cutout`]).
     pub fn cutout(mut self, name: &str, cutout: Cutout) -> Self {
         self.cutouts.insert(name.to_string(), cutout);
@@ -139,6 +151,7 @@ impl SceneBuilder {
             light_paths,
             textured,
             cutouts: cutouts_by_name,
+            sky_map,
             medium,
         } = self;
         let mut cutouts = vec![None; materials.len()];
@@ -181,6 +194,7 @@ impl SceneBuilder {
             light_paths,
             light_emission,
             cutouts: cutouts.clone(),
+            sky_map,
             medium: medium.filter(|m| !m.is_vacuum()),
             objects: placed,
             geometry: Geometry::default(),

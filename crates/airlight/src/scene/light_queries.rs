@@ -24,8 +24,47 @@ impl Scene {
     /// [`Scene::sample_emitter`].
     #[inline]
     pub fn sample_light(&self, index: usize, p: Vec3, u: Vec2) -> Option<LightSample> {
+        if let Some(sample) = self.mapped_sky_sample(index, u) {
+            return sample;
+        }
         let sample = self.lights[index].sample(p, u)?;
         Some(self.textured_sample(index, p, sample)).filter(|s| s.weight != Rgb::ZERO)
+    }
+
+    /// A sample of the sky light `index` drawn by its environment map's
+    /// power: Some(the sample, or None) when `index` is that light.
+    #[inline]
+    fn mapped_sky_sample(&self, index: usize, u: Vec2) -> Option<Option<LightSample>> {
+        let (sky, map) = self.sky_map.as_ref().filter(|(i, _)| *i as usize == index)?;
+        let Light::Sky { radiance: scale } = self.lights[*sky as usize] else { return Some(None) };
+        Some(map.sample(u).map(|(wi, l, pdf)| LightSample {
+            wi,
+            distance: f32::INFINITY,
+            weight: scale * l / pdf,
+            pdf,
+        }))
+    }
+
+    /// The radiance sky light `index` sends from the direction `dir`
+    /// (pointing toward the sky): its radiance, times its environment
+    /// map's there if it has one.
+    #[inline]
+    pub fn sky_radiance(&self, index: usize, dir: Vec3) -> Rgb {
+        let scale = self.lights[index].emitted(Vec3::ZERO, Vec3::ZERO);
+        match &self.sky_map {
+            Some((sky, map)) if *sky as usize == index => scale * map.radiance(dir.normalize()),
+            _ => scale,
+        }
+    }
+
+    /// The solid-angle density with which sampling sky light `index`
+    /// draws `dir`.
+    #[inline]
+    pub fn sky_pdf(&self, index: usize, dir: Vec3) -> f32 {
+        match &self.sky_map {
+            Some((sky, map)) if *sky as usize == index => map.pdf(dir.normalize()),
+            _ => self.lights[index].pdf(Vec3::ZERO, dir, f32::INFINITY),
+        }
     }
 
     /// A sample of light `index` from `p` with its weight taken from the
@@ -164,6 +203,9 @@ impl Scene {
     /// choices; for any other light, [`Scene::sample_light`].
     #[inline]
     pub fn sample_emitter(&self, first: usize, p: Vec3, u: Vec2) -> Option<LightSample> {
+        if let Some(sample) = self.mapped_sky_sample(first, u) {
+            return sample;
+        }
         let (index, sample) = self.emitters.sample(&self.lights, first, p, u)?;
         Some(self.textured_sample(index, p, sample)).filter(|s| s.weight != Rgb::ZERO)
     }

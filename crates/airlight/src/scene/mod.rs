@@ -55,6 +55,8 @@ pub struct Scene {
     /// Per material index: its cut-out, if any (glTF's alpha), which the
     /// geometry lets rays through.
     cutouts: Vec<Option<crate::material::Cutout>>,
+    /// The sky light whose radiance an environment map gives, and the map.
+    sky_map: Option<(u32, std::sync::Arc<crate::light::environment::EnvironmentMap>)>,
     /// Never a vacuum: a medium that neither absorbs nor scatters is none.
     medium: Option<Medium>,
     /// The scene's objects (not the lights' surfaces), in world space, with
@@ -242,13 +244,11 @@ impl Scene {
         &self.skies
     }
 
-    /// What a ray that leaves the scene sees, unweighted: the background
-    /// and every sky. (The path tracer weighs the skies against their
-    /// samples instead.)
-    pub fn escaped_radiance(&self) -> crate::Rgb {
-        self.skies
-            .iter()
-            .fold(self.settings.background, |sum, &i| sum + self.lights[i as usize].emitted(Vec3::ZERO, Vec3::ZERO))
+    /// What a ray along `dir` that leaves the scene sees, unweighted: the
+    /// background and every sky. (The path tracer weighs the skies against
+    /// their samples instead.)
+    pub fn escaped_radiance(&self, dir: Vec3) -> crate::Rgb {
+        self.skies.iter().fold(self.settings.background, |sum, &i| sum + self.sky_radiance(i as usize, dir))
     }
 
     /// Makes the scene's sky `radiance` (zero: no sky): the first sky light

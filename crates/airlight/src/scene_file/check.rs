@@ -197,11 +197,20 @@ impl Checker<'_> {
         for imported in included {
             builder = builder.parts(imported.parts);
         }
+        let mut mapped_skies = 0;
         for i in 0..desc.lights.len() {
-            let (light, motion) = self.light(i)?;
-            builder = match self.keyframes(i, &motion, &light)? {
-                Some(path) => builder.moving_light(light, path),
-                None => builder.light(light),
+            let (light, motion, map) = self.light(i)?;
+            builder = match (self.keyframes(i, &motion, &light)?, map, light) {
+                (_, Some(map), crate::light::Light::Sky { radiance }) => {
+                    mapped_skies += 1;
+                    if mapped_skies > 1 {
+                        let span = self.section_element("lights", i)?.span();
+                        return Err(self.err(span, format!("lights[{i}]: a scene has at most one sky with a `file`")));
+                    }
+                    builder.environment(radiance, map)
+                }
+                (Some(path), _, light) => builder.moving_light(light, path),
+                (None, _, light) => builder.light(light),
             };
         }
         builder.build()

@@ -523,7 +523,9 @@ falloff_keys! {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(crate) struct SkyLight {
-    pub radiance: Triple,
+    pub radiance: Option<Triple>,
+    /// An equirectangular environment map (Radiance HDR or OpenEXR).
+    pub file: Option<Spanned<String>>,
 }
 
 #[derive(Debug, Deserialize)]

@@ -3,15 +3,17 @@
 
 use super::check::{Checker, Result};
 use super::desc::*;
+use crate::light::environment::EnvironmentMap;
 use crate::light::{Attenuation, Keyframes, Light, SpotProfile};
 use crate::scene::limits;
 use glam::Vec3;
 use std::ops::Range;
+use std::sync::Arc;
 
 impl<'a> Checker<'a> {
     /// The `index`th `[[lights]]` table read by its type, and the light it
     /// makes, within [`limits::MAX_COORDINATE`] of the origin.
-    pub(super) fn light(&self, index: usize) -> Result<(Light, LightMotion)> {
+    pub(super) fn light(&self, index: usize) -> Result<(Light, LightMotion, Option<Arc<EnvironmentMap>>)> {
         let label = format!("lights[{index}]");
         let read = self.read_table::<LightDesc>(self.section_element("lights", index)?, &label)?;
         let label = format!("{label} ({})", read.name);
@@ -21,7 +23,15 @@ impl<'a> Checker<'a> {
         if extent > limits::MAX_COORDINATE {
             return Err(self.err(span, limits::too_far(&label, extent)));
         }
-        Ok((light, read.shared))
+        let map = match &read.kind {
+            LightDesc::Sky(SkyLight { file: Some(file), .. }) => {
+                Some(self.loader.environment_file(file.get_ref()).map_err(|why| {
+                    self.err(file.span(), format!("{label}.file: cannot load the environment map: {why}"))
+                })?)
+            }
+            _ => None,
+        };
+        Ok((light, read.shared, map))
     }
 
     fn light_values(&self, span: Range<usize>, label: &str, desc: &LightDesc) -> Result<Light> {
@@ -33,7 +43,9 @@ impl<'a> Checker<'a> {
                 (Light::point(point(l.position, "position")?, power(l.intensity, "intensity")?), l.falloff())
             }
             LightDesc::Spot(l) => (self.spot(span.clone(), label, l)?, l.falloff()),
-            LightDesc::Sky(l) => return Ok(Light::sky(power(l.radiance, "radiance")?)),
+            LightDesc::Sky(l) => {
+                return Ok(Light::sky(power(l.radiance.unwrap_or(Triple(Vec3::ONE)), "radiance")?));
+            }
             LightDesc::Distant(l) => {
                 let d = self.direction(span.clone(), &at("direction"), l.direction.0)?;
                 return Ok(Light::distant(d, power(l.irradiance, "irradiance")?));

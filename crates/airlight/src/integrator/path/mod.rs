@@ -342,12 +342,11 @@ impl PathTracer {
                 // and the skies, which next-event estimation samples too.
                 l += beta * scene.settings().background / avg(r_u);
                 for &index in scene.skies() {
-                    let light = &scene.lights()[index as usize];
-                    let le = light.emitted(Vec3::ZERO, ray.dir);
+                    let le = scene.sky_radiance(index as usize, ray.dir);
                     if depth == 0 {
                         l += beta * le / avg(r_u);
                     } else {
-                        let r_l = r_l * light.pdf(prev_p, ray.dir, f32::INFINITY);
+                        let r_l = r_l * scene.sky_pdf(index as usize, ray.dir);
                         l += beta * le * power_heuristic(r_u, r_l, hero);
                     }
                 }
