@@ -146,10 +146,27 @@ fn info(path: &Path) -> Result<(), String> {
     println!("geometry: {prims} bounded primitives, {planes} planes");
     println!("materials: {}", scene.materials().len());
     println!("lights: {}", scene.lights().len());
-    // An emitting mesh is a light per triangle: counted, not listed.
-    let triangles = scene.lights().iter().filter(|l| matches!(l, Light::Triangle { .. })).count();
-    if triangles > 0 {
-        println!("  {triangles} triangles of emitting meshes");
+    // An emitting mesh is a light per triangle: counted, not listed, with
+    // the power they send out (π × area × radiance each: a Lambertian
+    // emitter's, from one side), their textures' means where they glow
+    // unevenly.
+    let triangles: Vec<&Light> = scene.lights().iter().filter(|l| matches!(l, Light::Triangle { .. })).collect();
+    if !triangles.is_empty() {
+        let power = triangles.iter().fold(glam::DVec3::ZERO, |sum, l| match **l {
+            Light::Triangle { edge_1, edge_2, radiance, .. } => {
+                let area = 0.5 * edge_1.as_dvec3().cross(edge_2.as_dvec3()).length();
+                sum + radiance.as_dvec3() * (std::f64::consts::PI * area)
+            }
+            _ => sum,
+        });
+        let watts = |x: f64| format!("{x:.4}");
+        println!(
+            "  {} triangles of emitting meshes, sending out [{}, {}, {}] W in all",
+            triangles.len(),
+            watts(power.x),
+            watts(power.y),
+            watts(power.z)
+        );
     }
     let others = scene.lights().iter().zip(scene.light_paths()).filter(|(l, _)| !matches!(l, Light::Triangle { .. }));
     for (light, path) in others {

@@ -112,6 +112,14 @@ fn info_describes_a_scene() {
     assert!(out.status.success());
     let text = String::from_utf8(out.stdout).unwrap();
     assert!(text.contains("640×480") && text.contains("lights: 1"), "{text}");
+    // An emitting mesh is counted with its power: Blender's 1 m² lamp of
+    // radiance 4 sends out π × 1 m² × 4 = 12.566 W from its side.
+    let out = airlight(&scenes(), &["info", "models/blender_room.glb"]);
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert!(
+        text.contains("2 triangles of emitting meshes, sending out [12.5664, 12.5664, 12.5664] W in all"),
+        "{text}"
+    );
 }
 
 #[test]
