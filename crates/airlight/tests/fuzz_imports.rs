@@ -75,8 +75,10 @@ fn glb(json: &serde_json::Value, bin: Option<&[u8]>) -> Vec<u8> {
 }
 
 /// The example scenes' glTF files: a `.gltf` with a data URI buffer, a
-/// `.glb` with a binary chunk and a texture beside it, and the same GLB
-/// as a `.gltf` whose buffer is a file beside it.
+/// `.glb` with a binary chunk and a texture beside it, the same GLB as a
+/// `.gltf` whose buffer is a file beside it, and the GLB with its floor's
+/// material using every map Airlight reads (normal, emissive and
+/// metallic-roughness textures, a texture transform, a cut-out).
 fn gltf_bases() -> Vec<GltfBase> {
     let models = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/models");
     let lamp = serde_json::from_slice(&std::fs::read(models.join("lamp_room.gltf")).unwrap()).unwrap();
@@ -84,7 +86,18 @@ fn gltf_bases() -> Vec<GltfBase> {
     let floor = std::fs::read(models.join("blender_floor.png")).unwrap();
     let mut room_files = room.clone();
     room_files["buffers"][0]["uri"] = "room.bin".into();
+    let mut mapped = room.clone();
+    let floor_material = &mut mapped["materials"][0];
+    floor_material["normalTexture"] = serde_json::json!({ "index": 0, "scale": 0.8 });
+    floor_material["emissiveTexture"] = serde_json::json!({ "index": 0 });
+    floor_material["emissiveFactor"] = serde_json::json!([0.5, 0.4, 0.3]);
+    floor_material["alphaMode"] = "MASK".into();
+    floor_material["pbrMetallicRoughness"]["metallicFactor"] = 0.5.into();
+    floor_material["pbrMetallicRoughness"]["metallicRoughnessTexture"] = serde_json::json!({ "index": 0 });
+    floor_material["pbrMetallicRoughness"]["baseColorTexture"]["extensions"] =
+        serde_json::json!({ "KHR_texture_transform": { "offset": [0.1, 0.2], "rotation": 0.3, "scale": [2, 2] } });
     vec![
+        GltfBase { json: mapped, bin: bin.clone(), beside: vec![("blender_floor.png", floor.clone())] },
         GltfBase { json: lamp, bin: None, beside: vec![] },
         GltfBase { json: room, bin: bin.clone(), beside: vec![("blender_floor.png", floor.clone())] },
         GltfBase {
