@@ -3,11 +3,14 @@
 //! EXR images.
 
 use airlight::aov::{Aov, SurfaceAovs, in_scattered_aov, surface_aovs};
+use airlight::denoise::Denoiser;
 use airlight::film::Image;
 use airlight::integrator::Integrator;
 use airlight::scene::Scene;
+use std::borrow::Cow;
 use std::ops::Range;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 /// The AOVs `--aov` names (one value, a comma-separated list).
 #[derive(Clone, Debug)]
@@ -35,11 +38,41 @@ pub struct Layers {
     aovs: Vec<Aov>,
     surface: Option<SurfaceAovs>,
     in_scattered: Option<Image>,
+    /// `--denoise`: the library, which the first hits' albedo and normal guide.
+    denoiser: Option<Arc<Denoiser>>,
+}
+
+/// Where `--denoise` looks for Open Image Denoise: `AIRLIGHT_OIDN` (the
+/// library or its folder), a pip-installed `pyoidn`'s copy (as the
+/// `python3` on the path finds it), and the system's library path.
+pub fn oidn_candidates() -> Vec<PathBuf> {
+    let mut candidates: Vec<PathBuf> = std::env::var_os("AIRLIGHT_OIDN").map(PathBuf::from).into_iter().collect();
+    let script = "import os, pyoidn; print(os.path.join(os.path.dirname(pyoidn.__file__), 'oidn', 'lib'))";
+    if let Ok(out) =
+        std::process::Command::new("python3").args(["-c", script]).stderr(std::process::Stdio::null()).output()
+        && out.status.success()
+    {
+        let folder = String::from_utf8_lossy(&out.stdout).trim().to_string();
+        if !folder.is_empty() {
+            candidates.push(PathBuf::from(folder));
+        }
+    }
+    candidates.push(PathBuf::from(airlight::denoise::LIBRARY));
+    candidates
 }
 
 impl Layers {
     pub fn none() -> Self {
-        Layers { aovs: Vec::new(), surface: None, in_scattered: None }
+        Layers { aovs: Vec::new(), surface: None, in_scattered: None, denoiser: None }
+    }
+
+    /// The image to write: `image`, denoised when `--denoise` asked.
+    pub fn finish<'a>(&self, image: &'a Image) -> Result<Cow<'a, Image>, String> {
+        match (&self.denoiser, &self.surface) {
+            (Some(denoiser), Some(s)) => denoiser.denoise(image, Some((&s.albedo, &s.normal))).map(Cow::Owned),
+            (Some(denoiser), None) => denoiser.denoise(image, None).map(Cow::Owned),
+            _ => Ok(Cow::Borrowed(image)),
+        }
     }
 
     /// The first-hit outputs of the frame, over the camera rays of its
@@ -50,10 +83,9 @@ impl Layers {
         pool: &rayon::ThreadPool,
         aovs: &[Aov],
         samples: Range<u64>,
+        denoiser: Option<Arc<Denoiser>>,
     ) -> Self {
-        let surface = aovs
-            .iter()
-            .any(|a| matches!(a, Aov::Albedo | Aov::Normal | Aov::Depth))
+        let surface = (denoiser.is_some() || aovs.iter().any(|a| matches!(a, Aov::Albedo | Aov::Normal | Aov::Depth)))
             .then(|| pool.install(|| surface_aovs(scene, integrator.stratified(), samples.clone())));
         // A second pass over the render's own samples (as costly as the
         // render): checked to be possible in `check`.
@@ -61,7 +93,7 @@ impl Layers {
             .contains(&Aov::Inscatter)
             .then(|| pool.install(|| in_scattered_aov(scene, integrator, samples)))
             .flatten();
-        Layers { aovs: aovs.to_vec(), surface, in_scattered }
+        Layers { aovs: aovs.to_vec(), surface, in_scattered, denoiser }
     }
 
     pub fn wants_variance(&self) -> bool {

@@ -31,6 +31,7 @@
 
 pub mod assets;
 pub mod camera;
+pub mod denoise;
 pub mod film;
 pub mod geometry;
 pub mod integrator;

@@ -76,6 +76,12 @@ pub struct RenderArgs {
     pub(super) aov: Option<crate::aovs::AovList>,
     #[command(flatten)]
     pub(super) options: OptionFlags,
+    /// Denoise the image with Intel Open Image Denoise, guided by the first
+    /// hits' albedo and normal (`pip install pyoidn` provides the library,
+    /// or set AIRLIGHT_OIDN to it); not with --shard or --tile, whose sums
+    /// are merged first.
+    #[arg(long)]
+    pub(super) denoise: bool,
     /// No progress bar or summary.
     #[arg(long, short)]
     pub(super) quiet: bool,

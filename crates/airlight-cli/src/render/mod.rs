@@ -108,6 +108,14 @@ pub fn render(args: RenderArgs) -> Result<(), String> {
     }
     crate::preflight::render_memory(&scene, job.mode)?;
     crate::preflight::warn_if_dark(&scene, desc.kind != IntegratorKind::Direct);
+    // Found before any sample is spent: a missing library is said at once.
+    let denoiser = match (args.denoise, args.shard.is_some() || args.tile.is_some()) {
+        (false, _) => None,
+        (true, true) => {
+            return Err("--denoise: a part's sums are denoised after `airlight merge`, not before".into());
+        }
+        (true, false) => Some(std::sync::Arc::new(airlight::denoise::Denoiser::load(&crate::aovs::oidn_candidates())?)),
+    };
     let pool = job.thread_pool()?;
     let start = Instant::now();
     // Built once: between frames the integrator only hears that the lights
@@ -143,7 +151,14 @@ pub fn render(args: RenderArgs) -> Result<(), String> {
         };
         let layers_start = Instant::now();
         let outputs = FrameOutputs {
-            layers: Layers::of_frame(&scene, integrator.as_ref(), &pool, &job.aovs, job.samples.clone()),
+            layers: Layers::of_frame(
+                &scene,
+                integrator.as_ref(),
+                &pool,
+                &job.aovs,
+                job.samples.clone(),
+                denoiser.clone(),
+            ),
             ..outputs
         };
         if !job.aovs.is_empty() {
@@ -270,6 +285,8 @@ pub(crate) fn write_images(
     variance: Option<&Image>,
 ) -> Result<(), String> {
     let s = scene.settings();
+    let image = outputs.layers.finish(image)?;
+    let image = image.as_ref();
     for out in &outputs.images {
         let written = match outputs.layers.channels(variance) {
             Some(channels) if crate::aovs::is_exr(out) => image.save_exr_with_channels(out, &channels),
