@@ -284,7 +284,8 @@ fn a_gltf_emissive_texture_sets_each_triangles_radiance() {
 }
 
 /// The camera sees an emissive texture texel by texel, as a base colour
-/// texture under the sun: the same bilinear values, times the factor.
+/// texture under the sun: the same bilinear values, times the factor; and
+/// the glowing surface still reflects the sun by its base colour texture.
 #[test]
 fn a_gltf_emissive_texture_is_seen_point_by_point() {
     let dir = folder();
@@ -294,5 +295,7 @@ fn a_gltf_emissive_texture_is_seen_point_by_point() {
     let json = gltf(r#"{ "uri": "tex.png" }"#, r#", "sampler": 0"#, ATTRIBUTES)
         .replace(r#""extensions": { "KHR_materials_specular":"#, &format!("{emissive} \"KHR_materials_specular\":"));
     std::fs::write(dir.path().join("sq.gltf"), json).unwrap();
-    check("emissive", &render(&text, dir.path()), true, Vec3::new(1.0, 0.5, 0.25));
+    // Emitted (factor [1, 0.5, 0.25]) plus reflected (albedo factor
+    // [1, 0.5, 0.5] under irradiance π): the texture's value times their sum.
+    check("emissive", &render(&text, dir.path()), true, Vec3::new(2.0, 1.0, 0.75));
 }

@@ -225,42 +225,6 @@ impl Loader<'_> {
             if !(emission.is_finite() && emission.min_element() >= 0.0) {
                 return Err(format!("{at}: its material's emission is not finite and ≥ 0: {emission}"));
             }
-            let mut triangles = triangles;
-            if emission.max_element() > 0.0 && include.material.is_none() {
-                let Some(info) = material.emissive_texture() else {
-                    out.parts.lights.extend(Light::triangles_of(&positions, &triangles, emission));
-                    continue;
-                };
-                // Each triangle glows with the texture at each of its
-                // points; its light carries the texture's mean over it (its
-                // power, by which its mesh's triangles are drawn). The dark
-                // ones stay surfaces of the material.
-                let at_material = material.index().map_or("the default material".into(), |i| format!("materials[{i}]"));
-                let map = self
-                    .gltf_map(textures, &info, "emissiveTexture", false)
-                    .map_err(|why| format!("{at_material}.{why}"))?;
-                let uvs = texture_coordinates(&primitive, info_set(&info), positions.len(), buffers)
-                    .map_err(|why| format!("{at}: {why}"))?;
-                let mut dark = Vec::new();
-                for t in triangles {
-                    let corners = t.map(|i| uvs[i as usize]);
-                    let radiance = emission * map.mean_over_triangle(corners);
-                    if radiance.max_element() > 0.0 {
-                        let light = Light::triangles_of(&positions, &[t], radiance);
-                        if !light.is_empty() {
-                            let e = TexturedEmission { map: map.clone(), factor: emission, uvs: corners };
-                            out.parts.textured.push((out.parts.lights.len(), e));
-                            out.parts.lights.extend(light);
-                        }
-                    } else {
-                        dark.push(t);
-                    }
-                }
-                triangles = dark;
-                if triangles.is_empty() {
-                    continue;
-                }
-            }
             let mut uvs = Vec::new();
             let name = match include.material {
                 Some(name) => name.to_string(),
@@ -283,6 +247,46 @@ impl Loader<'_> {
                     name
                 }
             };
+            let mut triangles = triangles;
+            if emission.max_element() > 0.0 && include.material.is_none() {
+                // The glowing triangles reflect by the material too.
+                let Some(info) = material.emissive_texture() else {
+                    let first = out.parts.lights.len();
+                    out.parts.lights.extend(Light::triangles_of(&positions, &triangles, emission));
+                    out.parts.light_materials.extend((first..out.parts.lights.len()).map(|i| (i, name.clone())));
+                    continue;
+                };
+                // Each triangle glows with the texture at each of its
+                // points; its light carries the texture's mean over it (its
+                // power, by which its mesh's triangles are drawn). The dark
+                // ones stay surfaces of the material.
+                let at_material = material.index().map_or("the default material".into(), |i| format!("materials[{i}]"));
+                let map = self
+                    .gltf_map(textures, &info, "emissiveTexture", false)
+                    .map_err(|why| format!("{at_material}.{why}"))?;
+                let uvs = texture_coordinates(&primitive, info_set(&info), positions.len(), buffers)
+                    .map_err(|why| format!("{at}: {why}"))?;
+                let mut dark = Vec::new();
+                for t in triangles {
+                    let corners = t.map(|i| uvs[i as usize]);
+                    let radiance = emission * map.mean_over_triangle(corners);
+                    if radiance.max_element() > 0.0 {
+                        let light = Light::triangles_of(&positions, &[t], radiance);
+                        if !light.is_empty() {
+                            let e = TexturedEmission { map: map.clone(), factor: emission, uvs: corners };
+                            out.parts.textured.push((out.parts.lights.len(), e));
+                            out.parts.light_materials.push((out.parts.lights.len(), name.clone()));
+                            out.parts.lights.extend(light);
+                        }
+                    } else {
+                        dark.push(t);
+                    }
+                }
+                triangles = dark;
+                if triangles.is_empty() {
+                    continue;
+                }
+            }
             let normals =
                 vertex_normals(&primitive, world, positions.len(), buffers).map_err(|why| format!("{at}: {why}"))?;
             out.parts.objects.push((Shape::Mesh { positions, triangles, uvs, normals }, name));

@@ -321,7 +321,8 @@ impl Rows<'_> {
         for ((texel, light_hit), sampler) in texels.iter().zip(light_hits).zip(samplers.iter_mut()) {
             let (ray, k) = (&texel.ray, radiance.len());
             radiance.push(match (light_hit, &texel.hit) {
-                // A light's surface in front of the objects (it reflects nothing).
+                // A light's surface in front of the objects (black, or a glowing
+                // surface's material).
                 (Some(hit), _) => shadows.surface(scene, ray, &lights.surface(ray, *hit), sampler, k),
                 (None, Some(s)) => shadows.surface(scene, ray, s, sampler, k),
                 (None, None) => scene.escaped_radiance(ray.dir),

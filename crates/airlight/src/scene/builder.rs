@@ -28,6 +28,9 @@ pub(crate) struct Parts {
     pub textured: Vec<(usize, TexturedEmission)>,
     /// The cut-outs of the materials of `materials` (by name) that have one.
     pub cutouts: Vec<(String, Cutout)>,
+    /// The material each light of `lights` (by index) reflects by, for
+    /// glowing surfaces that also reflect (others reflect nothing).
+    pub light_materials: Vec<(usize, String)>,
 }
 
 /// Builds a [`Scene`] in Rust, as a World/Camera example in a tutorial would.
@@ -45,6 +48,8 @@ pub struct SceneBuilder {
     cutouts: HashMap<String, Cutout>,
     /// The sky light an environment map gives, by index, and the map.
     sky_map: Option<(u32, Arc<EnvironmentMap>)>,
+    /// Lights (by index) whose surfaces reflect by a material (by name).
+    light_materials: Vec<(usize, String)>,
     medium: Option<Medium>,
 }
 
@@ -79,6 +84,7 @@ impl SceneBuilder {
         }
         let offset = builder.lights.len();
         builder.textured.extend(parts.textured.into_iter().map(|(i, e)| (offset + i, e)));
+        builder.light_materials.extend(parts.light_materials.into_iter().map(|(i, m)| (offset + i, m)));
         parts.lights.into_iter().fold(builder, SceneBuilder::light)
     }
 
@@ -152,8 +158,18 @@ impl SceneBuilder {
             textured,
             cutouts: cutouts_by_name,
             sky_map,
+            light_materials: light_material_names,
             medium,
         } = self;
+        let mut light_materials = vec![super::LIGHT_SURFACE; lights.len()];
+        for (i, name) in light_material_names {
+            let Some(&index) = material_names.get(&name) else {
+                return Err(SceneError::new(format!("a glowing surface of unknown material `{name}`")));
+            };
+            if let Some(slot) = light_materials.get_mut(i) {
+                *slot = index;
+            }
+        }
         let mut cutouts = vec![None; materials.len()];
         for (name, cutout) in cutouts_by_name {
             let Some(&index) = material_names.get(&name) else {
@@ -195,6 +211,7 @@ impl SceneBuilder {
             light_emission,
             cutouts: cutouts.clone(),
             sky_map,
+            light_materials,
             medium: medium.filter(|m| !m.is_vacuum()),
             objects: placed,
             geometry: Geometry::default(),

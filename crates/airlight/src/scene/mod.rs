@@ -35,8 +35,9 @@ use emitters::Emitters;
 use glam::Vec3;
 pub use textured_emission::TexturedEmission;
 
-/// The material index of an area light's own surface: it reflects nothing.
-const LIGHT_SURFACE: u32 = u32::MAX;
+/// The material index of an area light's own surface: it reflects nothing
+/// (a glowing mesh's triangles take their material instead).
+pub(super) const LIGHT_SURFACE: u32 = u32::MAX;
 
 /// Everything a render needs, built and validated. See the module
 /// documentation for what it keeps in step.
@@ -57,6 +58,9 @@ pub struct Scene {
     cutouts: Vec<Option<crate::material::Cutout>>,
     /// The sky light whose radiance an environment map gives, and the map.
     sky_map: Option<(u32, std::sync::Arc<crate::light::environment::EnvironmentMap>)>,
+    /// Per light: the material its surface reflects by (a glowing
+    /// surface's own), or [`LIGHT_SURFACE`] (black).
+    light_materials: Vec<u32>,
     /// Never a vacuum: a medium that neither absorbs nor scatters is none.
     medium: Option<Medium>,
     /// The scene's objects (not the lights' surfaces), in world space, with
@@ -205,7 +209,14 @@ impl Scene {
             emitter: None,
         });
         let lights = self.lights.iter().enumerate().filter_map(|(i, light)| {
-            Some(Surface { shape: light.surface()?, material: LIGHT_SURFACE, emitter: Some(i as u32) })
+            let material = self.light_materials.get(i).copied().unwrap_or(LIGHT_SURFACE);
+            let mut shape = light.surface()?;
+            // A glowing triangle with texture coordinates (its emissive
+            // texture's) reflects by its material's textures there too.
+            if let (Shape::Mesh { uvs, .. }, Some(Some(e))) = (&mut shape, self.light_emission.get(i)) {
+                *uvs = e.uvs.to_vec();
+            }
+            Some(Surface { shape, material, emitter: Some(i as u32) })
         });
         objects.chain(lights)
     }
@@ -279,6 +290,7 @@ impl Scene {
         self.lights = lights.to_vec();
         self.light_paths.resize(self.lights.len(), None);
         self.light_emission.resize(self.lights.len(), None);
+        self.light_materials.resize(self.lights.len(), LIGHT_SURFACE);
         self.emitters = Emitters::new(&self.lights);
         self.light_culling = LightCulling::new(&self.lights, self.emitters.firsts());
         self.placed_delta = placed_delta(&self.lights);
