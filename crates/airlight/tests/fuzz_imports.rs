@@ -2,11 +2,13 @@
 //! back: glTF scenes (the JSON mutated as a tree, the binary chunk, data
 //! URI buffers and buffer files by byte, the GLB framing by byte) and
 //! partial EXR renders (read, then merged with a sound part as `merge`
-//! and `--resume` would). Each input runs under `catch_unwind`: a panic or
+//! and `--resume` would), and a sky's environment maps (Radiance HDR and
+//! OpenEXR, by byte, then rendered). Each input runs under `catch_unwind`: a panic or
 //! an empty error fails the test with the seed that replays it
 //! (`AIRLIGHT_FUZZ_SEED=… cargo test -p airlight --test fuzz_imports`).
 //!
-//! The normal run tries 10,000 glTF files and 10,000 partial files; the
+//! The normal run tries 10,000 glTF files, 10,000 partial files and 2,000
+//! environment maps; the
 //! ignored tests a million of each (`cargo test --release -p airlight
 //! --test fuzz_imports -- --ignored`). `AIRLIGHT_FUZZ_INPUTS` sets the count.
 
@@ -293,4 +295,52 @@ fn mutated_partial_files_never_panic_when_read_or_merged() {
 #[ignore = "a million inputs: run by hand (docs/developing.md, BENCHMARKS.md)"]
 fn a_million_mutated_partial_files() {
     fuzz_partials(count(1_000_000));
+}
+
+/// A sky's environment maps to mutate: a Radiance HDR image and an
+/// OpenEXR one (written by the `image` crate), 8 × 4 texels.
+fn environment_bases() -> Vec<Vec<u8>> {
+    let texels: Vec<image::Rgb<f32>> =
+        (0..32).map(|k| image::Rgb([k as f32 * 0.1, 1.0 / (k as f32 + 1.0), 0.5])).collect();
+    let mut hdr = Vec::new();
+    image::codecs::hdr::HdrEncoder::new(&mut hdr).encode(&texels, 8, 4).unwrap();
+    let flat: Vec<f32> = texels.iter().flat_map(|t| t.0).collect();
+    let mut exr = std::io::Cursor::new(Vec::new());
+    let buffer = image::ImageBuffer::<image::Rgb<f32>, Vec<f32>>::from_raw(8, 4, flat).unwrap();
+    image::DynamicImage::ImageRgb32F(buffer).write_to(&mut exr, image::ImageFormat::OpenExr).unwrap();
+    vec![hdr, exr.into_inner()]
+}
+
+/// Loads one mutated environment map as a scene's sky and renders a few
+/// samples of it.
+fn environment_input(seed: u64, bases: &[Vec<u8>], dir: &Path) -> Result<bool, String> {
+    let mut rng = Rng(seed);
+    let mut bytes = rng.pick(bases).clone();
+    mutate_bytes(&mut rng, &mut bytes, &[]);
+    std::fs::write(dir.join("sky.map"), &bytes).unwrap();
+    if replaying() {
+        std::fs::write("/tmp/airlight-fuzz-replay.sky", &bytes).unwrap();
+    }
+    let text = "[render]\nwidth = 4\nheight = 4\n[materials.m]\nalbedo = 0.5\n\
+                [[objects]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\nmaterial = \"m\"\n\
+                [[lights]]\ntype = \"sky\"\nfile = \"sky.map\"\n";
+    let file = match SceneFile::from_toml_str(text, Some(dir)) {
+        Ok(file) => file,
+        Err(e) if !e.to_string().contains("sky.map") => return Err(format!("the error does not name the file: {e}")),
+        Err(_) => return Ok(false),
+    };
+    let integrator = IntegratorDesc::new(IntegratorKind::Path).build(&file.scene).map_err(|e| e.to_string())?;
+    accumulate(&file.scene, integrator.as_ref(), 0..2, 0..4, &RenderObserver::default());
+    Ok(true)
+}
+
+fn fuzz_environments(n: u64) {
+    let dir = tempfile::tempdir().unwrap();
+    let bases = environment_bases();
+    fuzz("environment map", 0x5C1E, n, |seed| environment_input(seed, &bases, dir.path()));
+}
+
+#[test]
+fn mutated_environment_maps_never_panic_and_errors_name_the_file() {
+    fuzz_environments(count(2_000));
 }
