@@ -260,7 +260,7 @@ impl Loader<'_> {
                 // points; its light carries the texture's mean over it (its
                 // power, by which its mesh's triangles are drawn). The dark
                 // ones stay surfaces of the material.
-                let at_material = material.index().map_or("the default material".into(), |i| format!("materials[{i}]"));
+                let at_material = material_label(&material);
                 let map = self
                     .gltf_map(textures, &info, "emissiveTexture", false)
                     .map_err(|why| format!("{at_material}.{why}"))?;
@@ -313,16 +313,7 @@ impl Loader<'_> {
     /// surface) the Lambertian material it then is, which the integrators
     /// treat faster.
     fn gltf_material(&self, material: &gltf::Material, textures: &mut Textures) -> Result<Material, String> {
-        let at = material.index().map_or("the default material".to_string(), |i| format!("materials[{i}]"));
-        self.gltf_material_at(material, textures, &at)
-    }
-
-    fn gltf_material_at(
-        &self,
-        material: &gltf::Material,
-        textures: &mut Textures,
-        at: &str,
-    ) -> Result<Material, String> {
+        let at = &material_label(material);
         let pbr = material.pbr_metallic_roughness();
         let [r, g, b, _] = pbr.base_color_factor();
         let base = Vec3::new(r, g, b);
@@ -389,7 +380,7 @@ impl Loader<'_> {
     /// BLEND over the base colour's alpha, factor × texture; None for OPAQUE.
     fn gltf_cutout(&self, material: &gltf::Material, textures: &mut Textures) -> Result<Option<Cutout>, String> {
         use gltf::material::AlphaMode as Gltf;
-        let at = material.index().map_or("the default material".to_string(), |i| format!("materials[{i}]"));
+        let at = material_label(material);
         let mode = match material.alpha_mode() {
             Gltf::Opaque => return Ok(None),
             Gltf::Blend => AlphaMode::Blend,
@@ -415,6 +406,11 @@ impl Loader<'_> {
         };
         Ok(Some(Cutout { factor, map, mode }))
     }
+}
+
+/// How errors name a material: its JSON path, or the default material.
+fn material_label(material: &gltf::Material) -> String {
+    material.index().map_or("the default material".to_string(), |i| format!("materials[{i}]"))
 }
 
 /// The coordinate set a texture reads (a `KHR_texture_transform` may name another).

@@ -65,6 +65,8 @@ const LANES: usize = 8;
 #[derive(Default)]
 pub(super) struct LaneScratch {
     materials: Vec<Material>,
+    /// Per point, the normal it is shaded with when not its surface's.
+    shadings: Vec<Option<glam::Vec3>>,
     /// Per point, its BRDF where it is Lambertian (the lanes take those).
     lambertian: Vec<Option<Rgb>>,
     /// The points the lanes take.
@@ -80,13 +82,15 @@ pub(super) fn light_terms(scene: &Scene, points: &[LitPoint], scratch: &mut Lane
 
 /// [`light_terms`] with the lanes on the instruction set `isa`.
 fn light_terms_on(isa: Isa, scene: &Scene, points: &[LitPoint], scratch: &mut LaneScratch, out: &mut Vec<Candidate>) {
-    let LaneScratch { materials, lambertian, in_lanes } = scratch;
+    let LaneScratch { materials, shadings, lambertian, in_lanes } = scratch;
     materials.clear();
     materials.extend(points.iter().map(|point| scene.material_at(&point.surface)));
+    shadings.clear();
+    shadings.extend(points.iter().map(|point| scene.shading_normal(&point.surface)));
     let one_point = |k: usize, index: usize, out: &mut Vec<Candidate>| {
         let point = &points[k];
         if let Some((sample, contribution)) =
-            light_term(scene, index, &point.surface, point.wo, &materials[k], point.key)
+            light_term(scene, index, &point.surface, shadings[k], point.wo, &materials[k], point.key)
         {
             out.push(Candidate::new(scene, point, index, &sample, contribution));
         }
@@ -99,10 +103,9 @@ fn light_terms_on(isa: Isa, scene: &Scene, points: &[LitPoint], scratch: &mut La
         return;
     }
     lambertian.clear();
-    lambertian.extend(points.iter().zip(materials.iter()).map(|(point, m)| {
-        // A smooth-shaded point's BRDF depends on the directions.
-        let flat = scene.shading_normal(&point.surface).is_none();
-        m.lambertian_brdf(point.surface.p, point.surface.n).filter(|_| flat)
+    // A smooth-shaded point's BRDF depends on the directions.
+    lambertian.extend(points.iter().zip(materials.iter()).zip(shadings.iter()).map(|((point, m), shading)| {
+        m.lambertian_brdf(point.surface.p, point.surface.n).filter(|_| shading.is_none())
     }));
     in_lanes.clear();
     in_lanes.extend((0..points.len() as u32).filter(|&k| lambertian[k as usize].is_some()));
@@ -306,8 +309,9 @@ mod tests {
         let mut want: Vec<Vec<Candidate>> = vec![Vec::new(); points.len()];
         for point in &points {
             let material = scene.material_at(&point.surface);
+            let shading = scene.shading_normal(&point.surface);
             for &index in scene.emitter_firsts() {
-                let term = light_term(&scene, index as usize, &point.surface, point.wo, &material, point.key);
+                let term = light_term(&scene, index as usize, &point.surface, shading, point.wo, &material, point.key);
                 if let Some((sample, contribution)) = term {
                     want[point.sample].push(Candidate::new(&scene, point, index as usize, &sample, contribution));
                 }

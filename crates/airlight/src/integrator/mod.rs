@@ -365,22 +365,26 @@ pub(crate) fn for_each_light_term(
 ) {
     let wo = -ray.dir;
     let material = scene.material_at(surface);
+    let shading = scene.shading_normal(surface);
     let key = sampler.next_key();
     scene.for_each_emitter_at(surface.p, |index, _| {
-        if let Some((sample, contribution)) = light_term(scene, index, surface, wo, &material, key) {
+        if let Some((sample, contribution)) = light_term(scene, index, surface, shading, wo, &material, key) {
             term(index, &sample, contribution);
         }
     });
 }
 
 /// One term of [`for_each_light_term`]: the sample of emitter `index` drawn
-/// with `key` at `surface` (whose material is `material`), seen along `wo`,
-/// and its contribution f · weight · |cos|; None where it adds nothing.
+/// with `key` at `surface` (whose material is `material`, shaded by the
+/// normal `shading`, [`Scene::shading_normal`], found once per point by the
+/// caller), seen along `wo`, and its contribution f · weight · |cos|; None
+/// where it adds nothing.
 #[inline]
 pub(crate) fn light_term(
     scene: &Scene,
     index: usize,
     surface: &SurfaceHit,
+    shading: Option<glam::Vec3>,
     wo: glam::Vec3,
     material: &Material,
     key: u64,
@@ -391,7 +395,7 @@ pub(crate) fn light_term(
     if cos == 0.0 {
         return None;
     }
-    let f = material.brdf_at(surface.p, surface.n, scene.shading_normal(surface), wo, sample.wi);
+    let f = material.brdf_at(surface.p, surface.n, shading, wo, sample.wi);
     if f == Rgb::ZERO {
         return None;
     }
